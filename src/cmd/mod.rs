@@ -1,0 +1,4 @@
+//! One module per subcommand.
+pub mod albedo;
+pub mod eval;
+pub mod info;
