@@ -1,1 +1,13 @@
-//! brtf-radiance
+//! # brtf-radiance: Radiance scene text
+//!
+//! Reads and writes Radiance primitives (`modifier type identifier`, then
+//! the string, integer and real argument lists), and converts the six
+//! Ward-type material primitives to and from [`brtf_model::Material`].
+//! Errors carry the file and line: `file:line: message`.
+
+mod primitive;
+
+pub use primitive::{
+    Primitive, RadError, format_primitive, material_from_primitive, parse_primitives,
+    primitive_from_material, select_material,
+};
