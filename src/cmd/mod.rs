@@ -2,3 +2,4 @@
 pub mod albedo;
 pub mod eval;
 pub mod info;
+pub mod material;

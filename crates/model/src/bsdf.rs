@@ -56,8 +56,8 @@ pub struct Bsdf {
     alpha2_v: f64,
     /// ∂(alpha2_u)/∂a_u, ∂(alpha2_u)/∂a_v, ∂(alpha2_v)/∂a_u, ∂(alpha2_v)/∂a_v.
     dalpha2: [[f64; 2]; 2],
-    /// Added to α² for the reflected lobe (source widening).
-    reflect_widening: f64,
+    /// 1/(α² + widening) of the reflected lobe along û and v̂.
+    reflect_inv_width: (f64, f64),
     /// Added to α² for the transmitted lobe (`ω/π`).
     transmit_widening: f64,
     /// Roughness 0: no specular lobe in the direct term.
@@ -138,7 +138,10 @@ impl Bsdf {
             alpha2_u,
             alpha2_v,
             dalpha2,
-            reflect_widening,
+            reflect_inv_width: (
+                1.0 / (alpha2_u + reflect_widening),
+                1.0 / (alpha2_v + reflect_widening),
+            ),
             transmit_widening: omega / PI,
             pure,
             fresnel: variant == Variant::Radiance && pure && spec >= FRESNEL_THRESHOLD,
@@ -433,44 +436,44 @@ impl Bsdf {
         let h = l + v;
         let hn = h.z;
         let hh = h.dot(h);
-        let wu = self.alpha2_u + self.reflect_widening;
-        let wv = self.alpha2_v + self.reflect_widening;
+        let inv_hn2 = 1.0 / (hn * hn);
         let variant = self.options.variant;
         let norm = match variant {
-            Variant::Radiance => hh / (PI * hn * hn * hn * hn),
+            Variant::Radiance => hh * inv_hn2 * inv_hn2 * (1.0 / PI),
             Variant::Manual2004 => 1.0 / (4.0 * PI * ci * co),
             Variant::Ward1992 => 1.0 / (4.0 * PI * (ci * co).sqrt()),
         };
+        let cutoff = variant == Variant::Radiance;
         if !self.anisotropic {
+            let inv_w = self.reflect_inv_width.0;
             let x = match variant {
                 Variant::Ward1992 => 2.0 - 2.0 * hn / hh.sqrt(),
-                _ => (hh - hn * hn) / (hn * hn),
+                // tan²θ_h
+                _ => hh * inv_hn2 - 1.0,
             };
-            let value = norm * (-x / wu).exp() / wu;
-            let d = value * (x / wu - 1.0) / wu;
+            let value = norm * (-x * inv_w).exp() * inv_w;
             return Lobe {
                 value,
-                d_width_u: d,
+                d_width_u: value * (x * inv_w - 1.0) * inv_w,
                 d_width_v: 0.0,
-                passes_cutoff: variant != Variant::Radiance || value > FTINY,
+                passes_cutoff: !cutoff || value > FTINY,
             };
         }
+        let (inv_wu, inv_wv) = self.reflect_inv_width;
         let hu = h.dot(self.frame_u);
         let hv = h.dot(self.frame_v);
-        let (xu, xv) = match variant {
-            Variant::Ward1992 => {
-                // Seed 000: exponent -2[(ĥ·x)²/αx + (ĥ·y)²/αy]/(1 + ĥ·n), ĥ unit.
-                let denom = hh * (1.0 + hn / hh.sqrt()) * 0.5;
-                (hu * hu / denom, hv * hv / denom)
-            }
-            _ => (hu * hu / (hn * hn), hv * hv / (hn * hn)),
+        let scale = match variant {
+            // Seed 000: exponent -2[(ĥ·x)²/αx + (ĥ·y)²/αy]/(1 + ĥ·n), ĥ unit.
+            Variant::Ward1992 => 2.0 / (hh * (1.0 + hn / hh.sqrt())),
+            _ => inv_hn2,
         };
-        let value = norm * (-(xu / wu + xv / wv)).exp() / (wu * wv).sqrt();
+        let (xu, xv) = (hu * hu * scale, hv * hv * scale);
+        let value = norm * (-(xu * inv_wu + xv * inv_wv)).exp() * (inv_wu * inv_wv).sqrt();
         Lobe {
             value,
-            d_width_u: value * (xu / wu - 0.5) / wu,
-            d_width_v: value * (xv / wv - 0.5) / wv,
-            passes_cutoff: variant != Variant::Radiance || value > FTINY,
+            d_width_u: value * (xu * inv_wu - 0.5) * inv_wu,
+            d_width_v: value * (xv * inv_wv - 0.5) * inv_wv,
+            passes_cutoff: !cutoff || value > FTINY,
         }
     }
 

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# The one test command (README.md): installs what the tests need, checks
+# formatting and lints, then runs every test, including the live
+# comparisons against real Radiance (rtrace from the PyPI package pyradiance).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+# Real Radiance 6.0a binaries, in a project-local virtual environment.
+if ! .venv/bin/python -c "import pyradiance" 2>/dev/null; then
+    echo "== installing pyradiance 1.3.1 (real Radiance binaries) into .venv"
+    python3 -m venv .venv
+    .venv/bin/pip install --quiet --disable-pip-version-check pyradiance==1.3.1
+fi
+pkg=$(.venv/bin/python -c "import os, pyradiance; print(os.path.dirname(pyradiance.__file__))")
+export RADIANCE_BIN="$pkg/bin"
+export RAYPATH=".:$pkg/lib"
+echo "== Radiance: $("$RADIANCE_BIN/rtrace" -version 2>&1 | head -n 1)"
+
+echo "== cargo fmt --check"
+cargo fmt --all -- --check
+echo "== cargo clippy"
+cargo clippy --workspace --all-targets --quiet -- -D warnings
+echo "== cargo test"
+cargo test --workspace
+echo "== slow statistical tests (#[ignore]d in the default run)"
+cargo test --workspace -- --ignored

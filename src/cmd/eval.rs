@@ -1,0 +1,51 @@
+//! `brtf eval`: BSDF values for directions read as CSV on stdin.
+
+use super::material::MaterialArgs;
+use anyhow::{Context, Result, bail};
+use brtf_model::direction;
+use clap::Args;
+use std::io::{BufRead, BufWriter, Write};
+
+#[derive(Args, Debug)]
+pub struct EvalArgs {
+    #[command(flatten)]
+    pub material: MaterialArgs,
+    /// Incident polar angle θ_in in degrees (towards the light).
+    #[arg(long, allow_hyphen_values = true)]
+    pub theta_in: f64,
+    /// Incident azimuth φ_in in degrees.
+    #[arg(long, allow_hyphen_values = true)]
+    pub phi_in: f64,
+}
+
+pub fn run(args: EvalArgs) -> Result<()> {
+    let bsdf = args.material.bsdf()?;
+    let l = direction(args.theta_in, args.phi_in);
+    let stdin = std::io::stdin();
+    let stdout = std::io::stdout();
+    let mut out = BufWriter::new(stdout.lock());
+    writeln!(out, "theta_out,phi_out,r,g,b")?;
+    for (index, line) in stdin.lock().lines().enumerate() {
+        let number = index + 1;
+        let line = line.with_context(|| format!("<stdin>:{number}: cannot read"))?;
+        let trimmed = line.trim();
+        if trimmed.is_empty() || trimmed.starts_with('#') {
+            continue;
+        }
+        let fields: Vec<&str> = trimmed.split(',').map(str::trim).collect();
+        if fields.len() != 2 {
+            bail!("<stdin>:{number}: expected `theta_out,phi_out`, found {} fields", fields.len());
+        }
+        let parsed: Vec<Option<f64>> = fields.iter().map(|f| f.parse::<f64>().ok()).collect();
+        let (theta, phi) = match (parsed[0], parsed[1]) {
+            (Some(t), Some(p)) if t.is_finite() && p.is_finite() => (t, p),
+            // A header line such as `theta_out,phi_out`.
+            _ if number == 1 && parsed.iter().all(Option::is_none) => continue,
+            _ => bail!("<stdin>:{number}: `{trimmed}` is not two numbers (theta_out,phi_out in degrees)"),
+        };
+        let f = bsdf.eval(l, direction(theta, phi));
+        writeln!(out, "{},{},{},{},{}", theta, phi, f[0], f[1], f[2])?;
+    }
+    out.flush()?;
+    Ok(())
+}
