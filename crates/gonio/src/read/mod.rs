@@ -1,0 +1,520 @@
+//! Readers: bytes or files in, [`Measurement`] out.
+//!
+//! This module owns the entry points ([`read_path`], [`read_bytes`] and the
+//! per-format variants), format detection, and everything both readers
+//! share: the text check (empty, NUL bytes, invalid UTF-8), the line walk
+//! with 1-based line numbers, number fields with the sentinel rule, and the
+//! incidence found in a file name (`…:+15+0.mpc`). The format specifics
+//! live in [`mpc`] and [`mountain`].
+//!
+//! Input is read in one go and parsed from the byte buffer; rows are split
+//! on ASCII whitespace (spaces or tabs) and CRLF line ends are accepted.
+//! No input makes a reader panic.
+
+pub(crate) mod mountain;
+pub(crate) mod mpc;
+mod number;
+
+use std::path::Path;
+
+use crate::error::{ParseErrorKind, ReadError};
+use crate::measurement::{
+    Incidence, IncidenceOrigin, Measurement, SENTINEL_THRESHOLD, SourceFormat,
+};
+
+/// Reads a measurement file, choosing the format with [`detect_format`].
+pub fn read_path(path: &Path) -> Result<Measurement, ReadError> {
+    let bytes = read_file(path)?;
+    read_bytes(&bytes, path)
+}
+
+/// Reads a measurement file in the given format.
+pub fn read_path_as(path: &Path, format: SourceFormat) -> Result<Measurement, ReadError> {
+    let bytes = read_file(path)?;
+    read_bytes_as(&bytes, path, format)
+}
+
+/// Parses in-memory bytes, choosing the format with [`detect_format`].
+///
+/// `name` is used in error messages and, for `.mpc`, to find the incidence
+/// in the file name when the header lacks it.
+pub fn read_bytes(bytes: &[u8], name: impl AsRef<Path>) -> Result<Measurement, ReadError> {
+    let name = name.as_ref();
+    let format = detect_format(bytes, name);
+    read_bytes_as(bytes, name, format)
+}
+
+/// Parses in-memory text, choosing the format with [`detect_format`].
+pub fn read_str(text: &str, name: impl AsRef<Path>) -> Result<Measurement, ReadError> {
+    read_bytes(text.as_bytes(), name)
+}
+
+/// Parses in-memory bytes in the given format.
+pub fn read_bytes_as(
+    bytes: &[u8],
+    name: impl AsRef<Path>,
+    format: SourceFormat,
+) -> Result<Measurement, ReadError> {
+    let name = name.as_ref();
+    let text = check_text(bytes, name)?;
+    match format {
+        SourceFormat::Mpc => mpc::parse(text, name),
+        SourceFormat::Mountain => mountain::parse(text, name),
+    }
+}
+
+/// Guesses the format: a `.mpc` extension, then telltale header lines
+/// (`#format:` for Mountain; `#using beam file`, `#incident angle` or an
+/// eight-column `#theta phi beam-ref …` line for `.mpc`), then the column
+/// count of the first data row (8 means `.mpc`). Defaults to Mountain.
+pub fn detect_format(bytes: &[u8], name: &Path) -> SourceFormat {
+    let has_mpc_extension = name
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("mpc"));
+    if has_mpc_extension {
+        return SourceFormat::Mpc;
+    }
+    // Only the head of the file matters; invalid UTF-8 is reported later.
+    let head = &bytes[..bytes.len().min(64 * 1024)];
+    let head = String::from_utf8_lossy(head);
+    for line in head.lines() {
+        let line = line.trim();
+        if line.is_empty() {
+            continue;
+        }
+        if let Some(body) = line.strip_prefix('#') {
+            let body = body.trim_start().to_ascii_lowercase();
+            if body.starts_with("format:") || body.starts_with("intheta") {
+                return SourceFormat::Mountain;
+            }
+            if body.starts_with("using beam file")
+                || body.starts_with("incident angle")
+                || body.starts_with("theta phi beam-ref")
+            {
+                return SourceFormat::Mpc;
+            }
+        } else if line.split_ascii_whitespace().count() >= 2 {
+            return if line.split_ascii_whitespace().count() == mpc::COLUMNS {
+                SourceFormat::Mpc
+            } else {
+                SourceFormat::Mountain
+            };
+        }
+    }
+    SourceFormat::Mountain
+}
+
+fn read_file(path: &Path) -> Result<Vec<u8>, ReadError> {
+    std::fs::read(path).map_err(|source| ReadError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// Builds a parse error for `name` at `line`.
+pub(crate) fn parse_error(name: &Path, line: usize, kind: ParseErrorKind) -> ReadError {
+    ReadError::Parse {
+        path: name.to_path_buf(),
+        line,
+        kind,
+    }
+}
+
+/// Rejects empty and binary input and returns the text (without a BOM).
+fn check_text<'a>(bytes: &'a [u8], name: &Path) -> Result<&'a str, ReadError> {
+    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    if bytes.iter().all(u8::is_ascii_whitespace) {
+        return Err(parse_error(name, 1, ParseErrorKind::Empty));
+    }
+    let line_at = |offset: usize| 1 + bytes[..offset].iter().filter(|&&b| b == b'\n').count();
+    if bytes.contains(&0)
+        && let Some(offset) = bytes.iter().position(|&b| b == 0)
+    {
+        let kind = ParseErrorKind::Binary {
+            what: "NUL byte",
+            offset,
+        };
+        return Err(parse_error(name, line_at(offset), kind));
+    }
+    std::str::from_utf8(bytes).map_err(|e| {
+        let offset = e.valid_up_to();
+        let kind = ParseErrorKind::Binary {
+            what: "invalid UTF-8",
+            offset,
+        };
+        parse_error(name, line_at(offset), kind)
+    })
+}
+
+/// The non-blank lines of `text` with their 1-based numbers, `\r` removed.
+pub(crate) fn numbered_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
+    text.split('\n')
+        .enumerate()
+        .map(|(i, line)| {
+            let line = match line.as_bytes().last() {
+                Some(b'\r') => &line[..line.len() - 1],
+                _ => line,
+            };
+            (i + 1, line)
+        })
+        .filter(|(_, line)| !line.trim_ascii().is_empty())
+}
+
+/// A cursor over the whitespace-separated number fields of one data row.
+///
+/// This is the readers' hot loop: one byte scan per field, with the number
+/// parsed during the scan ([`number::parse_prefix`]). Any problem is
+/// reported as a wrong column count first (when the row does not have
+/// exactly `expected` fields), otherwise as the bad field.
+pub(crate) struct Row<'a> {
+    line: &'a str,
+    pos: usize,
+    expected: usize,
+    layout: &'static str,
+}
+
+impl<'a> Row<'a> {
+    pub(crate) fn new(line: &'a str, expected: usize, layout: &'static str) -> Self {
+        Self {
+            line,
+            pos: 0,
+            expected,
+            layout,
+        }
+    }
+
+    fn column_count_error(&self) -> Option<ParseErrorKind> {
+        let found = self.line.split_ascii_whitespace().count();
+        (found != self.expected).then_some(ParseErrorKind::ColumnCount {
+            expected: self.expected,
+            found,
+            layout: self.layout,
+        })
+    }
+
+    /// The next field as a finite number (`column` is 1-based).
+    #[inline]
+    pub(crate) fn number(
+        &mut self,
+        column: usize,
+        name: &'static str,
+    ) -> Result<f64, ParseErrorKind> {
+        let bytes = self.line.as_bytes();
+        while self.pos < bytes.len() && bytes[self.pos].is_ascii_whitespace() {
+            self.pos += 1;
+        }
+        let start = self.pos;
+        if let Some((value, used)) = number::parse_prefix(&bytes[start..]) {
+            let end = start + used;
+            if end == bytes.len() || bytes[end].is_ascii_whitespace() {
+                self.pos = end;
+                return Ok(value);
+            }
+        }
+        // Slow path: a missing field, an unusual spelling, or an error.
+        let mut end = start;
+        while end < bytes.len() && !bytes[end].is_ascii_whitespace() {
+            end += 1;
+        }
+        self.pos = end;
+        // Both ends sit next to ASCII bytes (or the ends), so they are char
+        // boundaries.
+        let field = &self.line[start..end];
+        match parse_number(field, column, name) {
+            Ok(value) if !field.is_empty() => Ok(value),
+            Ok(_) => Err(self.column_count_error().unwrap_or(ParseErrorKind::NotANumber {
+                column,
+                name,
+                text: String::new(),
+            })),
+            Err(kind) => Err(self.column_count_error().unwrap_or(kind)),
+        }
+    }
+
+    /// The next field as a value: like [`Row::number`], but the
+    /// `9.9e+37` sentinel becomes NaN.
+    #[inline]
+    pub(crate) fn value(&mut self, column: usize, name: &'static str) -> Result<f64, ParseErrorKind> {
+        let v = self.number(column, name)?;
+        Ok(if v.abs() >= SENTINEL_THRESHOLD {
+            f64::NAN
+        } else {
+            v
+        })
+    }
+
+    /// θ_out and φ_out, the first two fields, checked and normalised.
+    #[inline]
+    pub(crate) fn direction(&mut self) -> Result<(f64, f64), ParseErrorKind> {
+        let theta = self.number(1, "theta")?;
+        let phi = self.number(2, "phi")?;
+        check_direction(theta, phi)
+    }
+
+    /// Succeeds when no fields are left.
+    #[inline]
+    pub(crate) fn finish(self) -> Result<(), ParseErrorKind> {
+        let rest = &self.line.as_bytes()[self.pos..];
+        if rest.iter().all(u8::is_ascii_whitespace) {
+            Ok(())
+        } else {
+            Err(self.column_count_error().unwrap_or(ParseErrorKind::ColumnCount {
+                expected: self.expected,
+                found: self.expected + 1,
+                layout: self.layout,
+            }))
+        }
+    }
+}
+
+/// Parses a finite number. Literal `nan`/`inf` and overflow are errors.
+pub(crate) fn parse_number(
+    text: &str,
+    column: usize,
+    name: &'static str,
+) -> Result<f64, ParseErrorKind> {
+    match number::parse_f64(text) {
+        Ok(v) if v.is_finite() => Ok(v),
+        Ok(_) => Err(ParseErrorKind::NonFinite {
+            column,
+            name,
+            text: shorten(text),
+        }),
+        Err(_) => Err(ParseErrorKind::NotANumber {
+            column,
+            name,
+            text: shorten(text),
+        }),
+    }
+}
+
+/// Checks θ_out (must lie in [0, 180]) and normalises φ_out to [0, 360).
+pub(crate) fn check_direction(theta: f64, phi: f64) -> Result<(f64, f64), ParseErrorKind> {
+    if !(0.0..=180.0).contains(&theta) {
+        return Err(ParseErrorKind::AngleOutOfRange {
+            what: "theta_out",
+            value: theta,
+            min: 0.0,
+            max: 180.0,
+        });
+    }
+    if phi.abs() >= SENTINEL_THRESHOLD {
+        return Err(ParseErrorKind::AngleOutOfRange {
+            what: "phi_out",
+            value: phi,
+            min: -360.0,
+            max: 720.0,
+        });
+    }
+    Ok((theta, crate::measurement::normalize_phi_deg(phi)))
+}
+
+fn shorten(text: &str) -> String {
+    const MAX: usize = 40;
+    match text.char_indices().nth(MAX) {
+        Some((cut, _)) => format!("{}…", &text[..cut]),
+        None => text.to_owned(),
+    }
+}
+
+/// Tolerance (degrees) when comparing incidences from two sources.
+pub const INCIDENCE_TOLERANCE_DEG: f64 = 1e-3;
+
+/// Brings an incident angle pair into θ ∈ [0, 180], φ ∈ [0, 360).
+/// A negative θ (in-plane signed convention, `-15+0`) means (|θ|, φ + 180°).
+pub(crate) fn normalize_incidence(theta: f64, phi: f64) -> (f64, f64) {
+    let (theta, phi) = if theta < 0.0 {
+        (-theta, phi + 180.0)
+    } else {
+        (theta, phi)
+    };
+    (theta, crate::measurement::normalize_phi_deg(phi))
+}
+
+/// The incidence `(θ, φ)` encoded at the end of a file name, as in
+/// `pab-xenon-aluA-elox1-b:+15+0.mpc`: two signed decimal numbers at the end
+/// of the stem, at least one of them with an explicit `+`.
+pub fn incidence_from_file_name(name: &Path) -> Option<(f64, f64)> {
+    let file_name = name.file_name()?.to_str()?;
+    // Strip an alphabetic extension (".mpc", ".txt"), never "+15.5".
+    let stem = match file_name.rfind('.') {
+        Some(dot)
+            if dot + 1 < file_name.len()
+                && file_name[dot + 1..].bytes().all(|b| b.is_ascii_alphabetic()) =>
+        {
+            &file_name[..dot]
+        }
+        _ => file_name,
+    };
+    let (rest, phi_text) = split_trailing_signed_number(stem)?;
+    let (before, theta_text) = split_trailing_signed_number(rest)?;
+    if before.ends_with(|c: char| c.is_ascii_digit() || c == '.') {
+        return None;
+    }
+    if !theta_text.starts_with('+') && !phi_text.starts_with('+') {
+        return None;
+    }
+    let theta: f64 = theta_text.parse().ok()?;
+    let phi: f64 = phi_text.parse().ok()?;
+    (theta.is_finite() && phi.is_finite() && theta.abs() <= 180.0)
+        .then(|| normalize_incidence(theta, phi))
+}
+
+/// Splits `text` into `(before, "+12.5")` when it ends in a signed number.
+fn split_trailing_signed_number(text: &str) -> Option<(&str, &str)> {
+    let digits_start = text
+        .rfind(|c: char| !(c.is_ascii_digit() || c == '.'))
+        .map_or(0, |i| i + 1);
+    let digits = &text[digits_start..];
+    if !digits.bytes().any(|b| b.is_ascii_digit()) || digits_start == 0 {
+        return None;
+    }
+    let sign_at = digits_start - 1;
+    match text.as_bytes()[sign_at] {
+        b'+' | b'-' => Some((&text[..sign_at], &text[sign_at..])),
+        _ => None,
+    }
+}
+
+/// One incident angle found in a header, with its line.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct HeaderAngle {
+    pub value: f64,
+    pub line: usize,
+}
+
+/// Combines header and file-name incidence as the spec asks: the header
+/// wins, the name fills gaps, and a disagreement is an error naming both.
+/// `line` is where a missing angle is reported (the first data row).
+pub(crate) fn resolve_incidence(
+    header_theta: Option<HeaderAngle>,
+    header_phi: Option<HeaderAngle>,
+    name: &Path,
+    line: usize,
+    expected: &'static str,
+) -> Result<(Incidence, IncidenceOrigin), ReadError> {
+    let from_name = incidence_from_file_name(name);
+    let theta = match (header_theta, from_name) {
+        (Some(h), _) => h.value,
+        (None, Some((t, _))) => t,
+        (None, None) => {
+            let kind = ParseErrorKind::MissingIncidence {
+                missing: "theta",
+                expected,
+            };
+            return Err(parse_error(name, line, kind));
+        }
+    };
+    let phi = match (header_phi, from_name) {
+        (Some(h), _) => h.value,
+        (None, Some((_, p))) => p,
+        (None, None) => {
+            let kind = ParseErrorKind::MissingIncidence {
+                missing: "phi",
+                expected,
+            };
+            return Err(parse_error(name, line, kind));
+        }
+    };
+    let (theta, phi) = normalize_incidence(theta, phi);
+    let origin = if header_theta.is_some() && header_phi.is_some() {
+        IncidenceOrigin::Header
+    } else if header_theta.is_none() && header_phi.is_none() {
+        IncidenceOrigin::FileName
+    } else {
+        // Mixed: some from the header, the rest from the name.
+        IncidenceOrigin::Header
+    };
+    if let Some((name_theta, name_phi)) = from_name
+        && !same_incidence((theta, phi), (name_theta, name_phi))
+    {
+        let conflict_line = header_theta
+            .or(header_phi)
+            .map_or(line, |angle| angle.line);
+        let kind = ParseErrorKind::IncidenceConflict {
+            header_theta: theta,
+            header_phi: phi,
+            name_theta,
+            name_phi,
+            file_name: name
+                .file_name()
+                .map_or_else(String::new, |n| n.to_string_lossy().into_owned()),
+        };
+        return Err(parse_error(name, conflict_line, kind));
+    }
+    Ok((Incidence::new(theta, phi), origin))
+}
+
+/// True when two normalised incidences agree within
+/// [`INCIDENCE_TOLERANCE_DEG`]; φ is ignored at normal incidence.
+fn same_incidence(a: (f64, f64), b: (f64, f64)) -> bool {
+    if (a.0 - b.0).abs() > INCIDENCE_TOLERANCE_DEG {
+        return false;
+    }
+    let at_pole = a.0 < INCIDENCE_TOLERANCE_DEG || (180.0 - a.0) < INCIDENCE_TOLERANCE_DEG;
+    let dphi = (a.1 - b.1).rem_euclid(360.0);
+    at_pole || dphi.min(360.0 - dphi) <= INCIDENCE_TOLERANCE_DEG
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn file_name_incidence() {
+        let p = |s: &str| incidence_from_file_name(Path::new(s));
+        assert_eq!(p("pab-xenon-aluA-elox1-b:+15+0.mpc"), Some((15.0, 0.0)));
+        assert_eq!(p("dir/pab-aluA-st1:+30+0.mpc"), Some((30.0, 0.0)));
+        assert_eq!(p("x:+22.5-90.mpc"), Some((22.5, 270.0)));
+        assert_eq!(p("x:-15+0.mpc"), Some((15.0, 180.0)));
+        assert_eq!(p("x:+15.5+0"), Some((15.5, 0.0)));
+        assert_eq!(p("golden_paper.txt"), None);
+        assert_eq!(p("layer_020_030.txt"), None);
+        assert_eq!(p("sample-15-0.txt"), None);
+        assert_eq!(p("+15+0.mpc"), Some((15.0, 0.0)));
+        assert_eq!(p("x:+999+0.mpc"), None);
+    }
+
+    #[test]
+    fn rows_and_numbers() {
+        let mut row = Row::new("1\t2  3", 3, "a b c");
+        assert_eq!(row.number(1, "a"), Ok(1.0));
+        assert_eq!(row.number(2, "b"), Ok(2.0));
+        assert_eq!(row.number(3, "c"), Ok(3.0));
+        assert_eq!(row.finish(), Ok(()));
+        let mut short = Row::new("1 2", 3, "a b c");
+        short.number(1, "a").unwrap();
+        short.number(2, "b").unwrap();
+        assert!(matches!(
+            short.number(3, "c"),
+            Err(ParseErrorKind::ColumnCount { found: 2, .. })
+        ));
+        let mut long = Row::new("1 2 3 4", 3, "a b c");
+        for c in 1..=3 {
+            long.number(c, "x").unwrap();
+        }
+        assert!(matches!(
+            long.finish(),
+            Err(ParseErrorKind::ColumnCount { found: 4, .. })
+        ));
+        let mut bad = Row::new("1 x2 3", 3, "a b c");
+        bad.number(1, "a").unwrap();
+        assert!(matches!(
+            bad.number(2, "b"),
+            Err(ParseErrorKind::NotANumber { column: 2, .. })
+        ));
+        assert!(Row::new("9.9e+37", 1, "v").value(1, "v").unwrap().is_nan());
+        assert!(matches!(
+            parse_number("nan", 3, "v"),
+            Err(ParseErrorKind::NonFinite { .. })
+        ));
+        assert!(matches!(
+            parse_number("1e999", 3, "v"),
+            Err(ParseErrorKind::NonFinite { .. })
+        ));
+        assert!(matches!(
+            parse_number("1,5", 3, "v"),
+            Err(ParseErrorKind::NotANumber { .. })
+        ));
+    }
+}

@@ -1,0 +1,144 @@
+//! Decimal number parsing for data rows.
+//!
+//! This module owns the hot loop of the readers: turning a field like
+//! `89.98829` or `-4.574e-06` into an `f64`. Plain decimals with at most 19
+//! significant digits, a mantissa ≤ 2⁵³ and a decimal exponent within ±22
+//! take Clinger's exact fast path (one correctly rounded multiplication or
+//! division of two exactly representable numbers), which gives the same
+//! bits as `str::parse::<f64>`. Everything else (long mantissas, large
+//! exponents, `inf`, junk) goes through `str::parse::<f64>`, so results and
+//! accepted syntax never differ from the standard library.
+
+/// Exact powers of ten representable in `f64`.
+const POW10: [f64; 23] = [
+    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
+    1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
+];
+
+/// Parses `text` exactly like `text.parse::<f64>()`.
+#[inline]
+pub(crate) fn parse_f64(text: &str) -> Result<f64, std::num::ParseFloatError> {
+    match parse_prefix(text.as_bytes()) {
+        Some((v, used)) if used == text.len() => Ok(v),
+        _ => text.parse::<f64>(),
+    }
+}
+
+/// Clinger's fast path on the longest number-like prefix of `bytes`:
+/// `Some((value, bytes used))`, or `None` when the fast path does not apply
+/// (the caller then falls back to `str::parse`). The value is always finite.
+#[inline]
+pub(crate) fn parse_prefix(bytes: &[u8]) -> Option<(f64, usize)> {
+    let mut i = 0;
+    let negative = match bytes.first()? {
+        b'-' => {
+            i = 1;
+            true
+        }
+        b'+' => {
+            i = 1;
+            false
+        }
+        _ => false,
+    };
+    let mut mantissa: u64 = 0;
+    let mut digits = 0u32;
+    let mut exponent: i32 = 0;
+    let mut any_digit = false;
+    while let Some(&b) = bytes.get(i) {
+        if !b.is_ascii_digit() {
+            break;
+        }
+        any_digit = true;
+        if mantissa != 0 || b != b'0' {
+            digits += 1;
+            if digits > 19 {
+                return None;
+            }
+        }
+        mantissa = mantissa * 10 + u64::from(b - b'0');
+        i += 1;
+    }
+    if bytes.get(i) == Some(&b'.') {
+        i += 1;
+        while let Some(&b) = bytes.get(i) {
+            if !b.is_ascii_digit() {
+                break;
+            }
+            any_digit = true;
+            if mantissa != 0 || b != b'0' {
+                digits += 1;
+                if digits > 19 {
+                    return None;
+                }
+            }
+            mantissa = mantissa * 10 + u64::from(b - b'0');
+            exponent -= 1;
+            i += 1;
+        }
+    }
+    if !any_digit {
+        return None;
+    }
+    if let Some(&(b'e' | b'E')) = bytes.get(i) {
+        i += 1;
+        let exp_negative = match bytes.get(i) {
+            Some(b'-') => {
+                i += 1;
+                true
+            }
+            Some(b'+') => {
+                i += 1;
+                false
+            }
+            _ => false,
+        };
+        let start = i;
+        let mut e: i32 = 0;
+        while let Some(&b) = bytes.get(i) {
+            if !b.is_ascii_digit() {
+                break;
+            }
+            if e > 10_000 {
+                return None;
+            }
+            e = e * 10 + i32::from(b - b'0');
+            i += 1;
+        }
+        if i == start {
+            return None;
+        }
+        exponent += if exp_negative { -e } else { e };
+    }
+    if mantissa > (1u64 << 53) {
+        return None;
+    }
+    let m = mantissa as f64;
+    let magnitude = if exponent >= 0 {
+        m * *POW10.get(usize::try_from(exponent).ok()?)?
+    } else {
+        m / *POW10.get(usize::try_from(-exponent).ok()?)?
+    };
+    Some((if negative { -magnitude } else { magnitude }, i))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn agrees_with_std_bit_for_bit() {
+        let cases = [
+            "0", "-0", "+0", "0.0", "89.98829", "-4.574e-06", "2.138e-06", "9.9e+37", "1e22",
+            "1e23", "1e-22", "1e-23", "123456789012345678", "1234567890123456789",
+            "12345678901234567890", "9007199254740993", "0.1", "3.", ".5", "-.5", "5e", "e5",
+            "1e+", "--1", "1.2.3", "", "-", "+", "inf", "NaN", "0x10", "1_0", "0.000000000000000000001",
+            "4.9e-324", "1.7976931348623157e308", "00000000000000000000000001.5", "1E5", "7e-0",
+        ];
+        for text in cases {
+            let ours = parse_f64(text).map(f64::to_bits).ok();
+            let std = text.parse::<f64>().map(f64::to_bits).ok();
+            assert_eq!(ours, std, "{text:?}");
+        }
+    }
+}

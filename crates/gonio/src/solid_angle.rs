@@ -1,0 +1,373 @@
+//! Per-sample solid angles (quadrature weights) from the sample directions.
+//!
+//! This module owns the answer to "how much of the sphere does each sample
+//! stand for?". [`solid_angles`] uses the file's Voronoi cell sizes when
+//! every sample has a valid one and otherwise calls
+//! [`compute_solid_angles`], which works on the directions alone:
+//!
+//! 1. Each hemisphere is handled on its own. Its directions are mapped to
+//!    the plane with the Lambert azimuthal equal-area projection about the
+//!    hemisphere's normal, `r = 2 sin(θ'/2)`, `(x, y) = r (cos φ, sin φ)`,
+//!    where θ' is the angle from that normal. The hemisphere becomes the
+//!    disk of radius √2, and **areas are preserved**: a region's planar area
+//!    equals its solid angle in sr.
+//! 2. The planar Voronoi diagram of the projected points (via a Delaunay
+//!    triangulation, `delaunator`) partitions the plane. A ring of 32 ghost
+//!    points at radius 3√2 closes the outer cells; no ghost cell reaches
+//!    into the disk, because every disk point is at most 2√2 from any
+//!    sample and at least 2√2 from any ghost.
+//! 3. Each cell is intersected exactly with the disk (polygon ∩ circle,
+//!    arcs included). The clipped cell areas are the solid angles; they sum
+//!    to 2π per hemisphere up to rounding.
+//!
+//! The cells are the equal-area images of a partition of the hemisphere in
+//! which every sample owns the region of directions nearest to it in the
+//! projected plane: not the spherical Voronoi cells, but an exact
+//! partition, so a constant integrates exactly and smooth functions to
+//! quadrature accuracy. Coincident directions (after rounding the projected
+//! coordinates to 2⁻³⁰) share one cell equally; non-finite directions get
+//! weight 0. The result is deterministic and independent of the sample
+//! order: points are sorted by their projected coordinates before the
+//! triangulation.
+
+use std::collections::HashMap;
+
+use delaunator::{EMPTY, Point, next_halfedge, triangulate};
+use serde::{Deserialize, Serialize};
+
+use crate::measurement::{Hemisphere, Measurement, Sample};
+
+/// Where a set of solid angles came from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SolidAngleSource {
+    /// The file's Voronoi cell sizes (`.mpc` column 8, or
+    /// [`Sample::solid_angle_sr`] set by code).
+    File,
+    /// Computed from the sample directions by [`compute_solid_angles`].
+    Computed,
+}
+
+/// Per-sample solid angles, parallel to [`Measurement::samples`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct SolidAngles {
+    /// Solid angle of each sample, sr.
+    pub per_sample_sr: Vec<f64>,
+    /// Where they came from.
+    pub source: SolidAngleSource,
+}
+
+/// Radius of the equal-area disk that one hemisphere maps to (√2).
+pub const DISK_RADIUS: f64 = std::f64::consts::SQRT_2;
+
+/// Projected coordinates are rounded to multiples of this (2⁻³⁰ ≈ 9.3e-10,
+/// about 5e-8 degrees), so the triangulation never sees near-duplicates.
+const GRID: f64 = 1.0 / (1u64 << 30) as f64;
+
+/// Number of ghost points closing the outer Voronoi cells.
+const GHOSTS: usize = 32;
+
+/// The solid angles to use for `measurement`: the file's when every sample
+/// has a finite, non-negative one, computed ones otherwise.
+pub fn solid_angles(measurement: &Measurement) -> SolidAngles {
+    let from_file: Option<Vec<f64>> = measurement
+        .samples
+        .iter()
+        .map(|s| s.solid_angle_sr.filter(|w| w.is_finite() && *w >= 0.0))
+        .collect();
+    match from_file {
+        Some(per_sample_sr) if !per_sample_sr.is_empty() => SolidAngles {
+            per_sample_sr,
+            source: SolidAngleSource::File,
+        },
+        _ => SolidAngles {
+            per_sample_sr: compute_solid_angles(&measurement.samples),
+            source: SolidAngleSource::Computed,
+        },
+    }
+}
+
+impl Measurement {
+    /// Sets every sample's [`Sample::solid_angle_sr`] from
+    /// [`solid_angles`], so the weights survive later selections.
+    pub fn fill_solid_angles(&mut self) -> SolidAngleSource {
+        let weights = solid_angles(self);
+        for (sample, w) in self.samples.iter_mut().zip(&weights.per_sample_sr) {
+            sample.solid_angle_sr = Some(*w);
+        }
+        weights.source
+    }
+}
+
+/// Solid angles (sr) computed from the sample directions alone; see the
+/// module docs. Each hemisphere's weights sum to 2π when it has samples.
+pub fn compute_solid_angles(samples: &[Sample]) -> Vec<f64> {
+    let mut weights = vec![0.0; samples.len()];
+    for hemisphere in [Hemisphere::Front, Hemisphere::Back] {
+        let mut indices = Vec::new();
+        let mut points = Vec::new();
+        for (i, s) in samples.iter().enumerate() {
+            let valid = s.theta_deg.is_finite()
+                && (0.0..=180.0).contains(&s.theta_deg)
+                && s.phi_deg.is_finite();
+            if valid && s.hemisphere() == hemisphere {
+                indices.push(i);
+                points.push(project(s.theta_deg, s.phi_deg, hemisphere));
+            }
+        }
+        let areas = disk_voronoi_areas(&points);
+        for (i, area) in indices.into_iter().zip(areas) {
+            weights[i] = area;
+        }
+    }
+    weights
+}
+
+/// Lambert azimuthal equal-area projection of a direction about the normal
+/// of `hemisphere`, rounded to the grid.
+pub fn project(theta_deg: f64, phi_deg: f64, hemisphere: Hemisphere) -> [f64; 2] {
+    let from_normal = match hemisphere {
+        Hemisphere::Front => theta_deg,
+        Hemisphere::Back => 180.0 - theta_deg,
+    };
+    let r = 2.0 * (from_normal.to_radians() / 2.0).sin();
+    let (sp, cp) = phi_deg.to_radians().sin_cos();
+    [snap(r * cp), snap(r * sp)]
+}
+
+fn snap(v: f64) -> f64 {
+    (v / GRID).round() * GRID
+}
+
+/// Areas of the Voronoi cells of `points` clipped to the disk of radius
+/// [`DISK_RADIUS`]. Coincident points share their cell equally.
+pub fn disk_voronoi_areas(points: &[[f64; 2]]) -> Vec<f64> {
+    let n = points.len();
+    let mut areas = vec![0.0; n];
+    if n == 0 {
+        return areas;
+    }
+
+    // Group coincident points; `unique[k]` is the representative point.
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|&a, &b| {
+        let ka = (points[a][0], points[a][1]);
+        let kb = (points[b][0], points[b][1]);
+        ka.0.total_cmp(&kb.0).then(ka.1.total_cmp(&kb.1))
+    });
+    let mut unique: Vec<[f64; 2]> = Vec::with_capacity(n + GHOSTS);
+    let mut group_of = vec![0usize; n];
+    for (pos, &i) in order.iter().enumerate() {
+        let is_new = pos == 0 || points[order[pos - 1]] != points[i];
+        if is_new {
+            unique.push(points[i]);
+        }
+        group_of[i] = unique.len() - 1;
+    }
+    let real = unique.len();
+    let unique_areas = unique_cell_areas(&mut unique);
+    debug_assert_eq!(unique.len(), real + GHOSTS);
+
+    let mut group_size = vec![0usize; real];
+    for &g in &group_of {
+        group_size[g] += 1;
+    }
+    for i in 0..n {
+        let g = group_of[i];
+        areas[i] = unique_areas[g] / group_size[g] as f64;
+    }
+    areas
+}
+
+/// Cell areas of the distinct points in `unique` (ghosts are appended to
+/// it). Returns one area per original entry.
+fn unique_cell_areas(unique: &mut Vec<[f64; 2]>) -> Vec<f64> {
+    let real = unique.len();
+    let ghost_radius = 3.0 * DISK_RADIUS;
+    for k in 0..GHOSTS {
+        let a = std::f64::consts::TAU * k as f64 / GHOSTS as f64;
+        unique.push([ghost_radius * a.cos(), ghost_radius * a.sin()]);
+    }
+    let input: Vec<Point> = unique.iter().map(|&[x, y]| Point { x, y }).collect();
+    let tri = triangulate(&input);
+
+    let circumcenters: Vec<[f64; 2]> = tri
+        .triangles
+        .chunks_exact(3)
+        .map(|t| circumcenter(unique[t[0]], unique[t[1]], unique[t[2]]))
+        .collect();
+    // One halfedge ending at each point.
+    let mut incoming = vec![EMPTY; unique.len()];
+    for e in 0..tri.triangles.len() {
+        incoming[tri.triangles[next_halfedge(e)]] = e;
+    }
+
+    let mut areas = vec![0.0; real];
+    let mut missing = Vec::new();
+    let mut polygon: Vec<[f64; 2]> = Vec::with_capacity(16);
+    for p in 0..real {
+        let start = incoming[p];
+        if start == EMPTY {
+            missing.push(p);
+            continue;
+        }
+        polygon.clear();
+        let mut e = start;
+        let mut closed = false;
+        for _ in 0..tri.triangles.len() {
+            polygon.push(circumcenters[e / 3]);
+            let twin = tri.halfedges[next_halfedge(e)];
+            if twin == EMPTY {
+                break;
+            }
+            e = twin;
+            if e == start {
+                closed = true;
+                break;
+            }
+        }
+        if closed {
+            areas[p] = disk_polygon_area(&polygon, DISK_RADIUS).abs();
+        } else {
+            missing.push(p);
+        }
+    }
+    if !missing.is_empty() {
+        share_with_nearest(unique, real, &missing, &mut areas);
+    }
+    areas
+}
+
+/// Points the triangulation skipped (never seen with snapped, distinct
+/// input, but handled): each shares the cell of its nearest triangulated
+/// neighbour.
+fn share_with_nearest(points: &[[f64; 2]], real: usize, missing: &[usize], areas: &mut [f64]) {
+    let is_missing: Vec<bool> = {
+        let mut v = vec![false; real];
+        for &m in missing {
+            v[m] = true;
+        }
+        v
+    };
+    let mut sharers: HashMap<usize, Vec<usize>> = HashMap::new();
+    for &m in missing {
+        let nearest = (0..real)
+            .filter(|&q| !is_missing[q])
+            .min_by(|&a, &b| dist2(points[a], points[m]).total_cmp(&dist2(points[b], points[m])));
+        if let Some(q) = nearest {
+            sharers.entry(q).or_default().push(m);
+        }
+    }
+    let mut owners: Vec<_> = sharers.into_iter().collect();
+    owners.sort_unstable_by_key(|(q, _)| *q);
+    for (q, ms) in owners {
+        let share = areas[q] / (ms.len() + 1) as f64;
+        areas[q] = share;
+        for m in ms {
+            areas[m] = share;
+        }
+    }
+}
+
+fn dist2(a: [f64; 2], b: [f64; 2]) -> f64 {
+    (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)
+}
+
+fn circumcenter(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> [f64; 2] {
+    let (bx, by) = (b[0] - a[0], b[1] - a[1]);
+    let (cx, cy) = (c[0] - a[0], c[1] - a[1]);
+    let b2 = bx * bx + by * by;
+    let c2 = cx * cx + cy * cy;
+    let d = 2.0 * (bx * cy - by * cx);
+    [a[0] + (cy * b2 - by * c2) / d, a[1] + (bx * c2 - cx * b2) / d]
+}
+
+/// Signed area of `polygon ∩ disk(0, radius)` (positive for
+/// counter-clockwise polygons).
+pub fn disk_polygon_area(polygon: &[[f64; 2]], radius: f64) -> f64 {
+    let n = polygon.len();
+    (0..n)
+        .map(|i| disk_triangle_area(polygon[i], polygon[(i + 1) % n], radius))
+        .sum()
+}
+
+/// Signed area of `triangle(origin, a, b) ∩ disk(0, r)`.
+fn disk_triangle_area(a: [f64; 2], b: [f64; 2], r: f64) -> f64 {
+    let d = [b[0] - a[0], b[1] - a[1]];
+    let qa = d[0] * d[0] + d[1] * d[1];
+    if !(qa > 0.0) || !qa.is_finite() {
+        return 0.0;
+    }
+    let qb = a[0] * d[0] + a[1] * d[1];
+    let qc = a[0] * a[0] + a[1] * a[1] - r * r;
+    let disc = qb * qb - qa * qc;
+    let mut cuts = [0.0, 1.0, 1.0, 1.0];
+    let mut count = 1;
+    if disc > 0.0 {
+        let root = disc.sqrt();
+        for t in [(-qb - root) / qa, (-qb + root) / qa] {
+            if t > 0.0 && t < 1.0 {
+                cuts[count] = t;
+                count += 1;
+            }
+        }
+    }
+    cuts[count] = 1.0;
+    let at = |t: f64| [a[0] + t * d[0], a[1] + t * d[1]];
+    let mut area = 0.0;
+    for k in 0..count {
+        let (s, e) = (cuts[k], cuts[k + 1]);
+        if e <= s {
+            continue;
+        }
+        let (p, q) = (at(s), at(e));
+        let mid = at(0.5 * (s + e));
+        let cross = p[0] * q[1] - p[1] * q[0];
+        if mid[0] * mid[0] + mid[1] * mid[1] <= r * r {
+            area += 0.5 * cross;
+        } else {
+            let dot = p[0] * q[0] + p[1] * q[1];
+            area += 0.5 * r * r * cross.atan2(dot);
+        }
+    }
+    area
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    #[test]
+    fn disk_clipping_of_simple_shapes() {
+        // A square much larger than the disk: the whole disk.
+        let big = [[-10.0, -10.0], [10.0, -10.0], [10.0, 10.0], [-10.0, 10.0]];
+        assert!((disk_polygon_area(&big, 1.0) - PI).abs() < 1e-12);
+        // A square inside the disk: the square.
+        let small = [[-0.5, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]];
+        assert!((disk_polygon_area(&small, 1.0) - 1.0).abs() < 1e-12);
+        // Half-plane x > 0 cut by a big rectangle: half the disk.
+        let half = [[0.0, -10.0], [10.0, -10.0], [10.0, 10.0], [0.0, 10.0]];
+        assert!((disk_polygon_area(&half, 1.0) - PI / 2.0).abs() < 1e-12);
+        // A square offset so that it is off-centre and partly outside.
+        let off = [[0.5, -0.25], [2.0, -0.25], [2.0, 0.25], [0.5, 0.25]];
+        let a = disk_polygon_area(&off, 1.0);
+        assert!(a > 0.0 && a < 0.5 * 0.5, "{a}");
+    }
+
+    #[test]
+    fn cells_partition_the_disk() {
+        for pts in [
+            vec![[0.0, 0.0]],
+            vec![[0.1, 0.0], [-0.1, 0.0]],
+            vec![[0.1, 0.0], [0.2, 0.0], [0.3, 0.0]], // collinear
+            vec![[0.5, 0.5], [0.5, 0.5], [-0.3, 0.2]], // duplicate
+        ] {
+            let areas = disk_voronoi_areas(&pts);
+            let total: f64 = areas.iter().sum();
+            assert!((total - 2.0 * PI).abs() < 1e-9, "{pts:?}: {areas:?}");
+        }
+        let dup = disk_voronoi_areas(&[[0.5, 0.5], [0.5, 0.5], [-0.3, 0.2]]);
+        assert_eq!(dup[0], dup[1]);
+    }
+}
