@@ -1,0 +1,187 @@
+//! Shared helpers: run `brtf`, parse its CSV, temporary files.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+/// Path of the binary under test.
+pub const BRTF: &str = env!("CARGO_BIN_EXE_brtf");
+
+/// The outcome of one `brtf` run.
+#[derive(Debug)]
+pub struct Run {
+    pub success: bool,
+    pub code: Option<i32>,
+    pub stdout: String,
+    pub stderr: String,
+    /// The command line, for failure messages.
+    pub command: String,
+}
+
+impl Run {
+    /// Panics (with the whole run in the message) unless the run succeeded.
+    #[track_caller]
+    pub fn ok(self) -> String {
+        assert!(self.success, "expected success, got {self}");
+        self.stdout
+    }
+
+    /// Panics unless the run failed with a non-zero exit code; returns stderr.
+    #[track_caller]
+    pub fn err(self) -> String {
+        assert!(!self.success, "expected failure, got {self}");
+        assert!(
+            matches!(self.code, Some(c) if c != 0),
+            "expected a non-zero exit code, got {self}"
+        );
+        assert!(
+            !self.stderr.trim().is_empty(),
+            "failure without a message: {self}"
+        );
+        self.stderr
+    }
+}
+
+impl std::fmt::Display for Run {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "`{}` exit {:?}\n--- stdout ---\n{}\n--- stderr ---\n{}",
+            self.command, self.code, self.stdout, self.stderr
+        )
+    }
+}
+
+/// Runs `brtf args...` with `stdin` as its standard input.
+pub fn brtf<S: AsRef<str>>(args: &[S], stdin: &str) -> Run {
+    let args: Vec<&str> = args.iter().map(AsRef::as_ref).collect();
+    let mut child = Command::new(BRTF)
+        .args(&args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap_or_else(|e| panic!("cannot start {BRTF}: {e}"));
+    let mut pipe = child.stdin.take().expect("stdin is piped");
+    let input = stdin.to_owned();
+    // Write from a thread so that a large input cannot dead-lock against a
+    // full stdout pipe. brtf may exit early (on an error) and close its end.
+    let writer = std::thread::spawn(move || {
+        let _ = pipe.write_all(input.as_bytes());
+    });
+    let output = child.wait_with_output().expect("wait for brtf");
+    writer.join().expect("stdin writer");
+    Run {
+        success: output.status.success(),
+        code: output.status.code(),
+        stdout: String::from_utf8_lossy(&output.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&output.stderr).into_owned(),
+        command: format!("brtf {}", args.join(" ")),
+    }
+}
+
+/// A CSV table with a header and numeric rows.
+#[derive(Debug, Clone)]
+pub struct Csv {
+    pub header: Vec<String>,
+    pub rows: Vec<Vec<f64>>,
+}
+
+impl Csv {
+    /// Index of a column by name.
+    #[track_caller]
+    pub fn col(&self, name: &str) -> usize {
+        self.header
+            .iter()
+            .position(|h| h == name)
+            .unwrap_or_else(|| panic!("no column `{name}` in {:?}", self.header))
+    }
+
+    /// The values of one column.
+    pub fn column(&self, name: &str) -> Vec<f64> {
+        let i = self.col(name);
+        self.rows.iter().map(|r| r[i]).collect()
+    }
+}
+
+/// Parses CSV output: a header line, then rows of numbers with as many
+/// fields as the header.
+#[track_caller]
+pub fn parse_csv(text: &str) -> Csv {
+    let mut lines = text.lines();
+    let header: Vec<String> = lines
+        .next()
+        .unwrap_or_else(|| panic!("empty CSV output"))
+        .split(',')
+        .map(|s| s.trim().to_owned())
+        .collect();
+    let rows = lines
+        .enumerate()
+        .map(|(i, line)| {
+            let row: Vec<f64> = line
+                .split(',')
+                .map(|f| {
+                    f.trim().parse::<f64>().unwrap_or_else(|_| {
+                        panic!("line {}: `{f}` is not a number in `{line}`", i + 2)
+                    })
+                })
+                .collect();
+            assert_eq!(
+                row.len(),
+                header.len(),
+                "line {}: `{line}` vs header {header:?}",
+                i + 2
+            );
+            row
+        })
+        .collect();
+    Csv { header, rows }
+}
+
+/// A fresh temporary directory (removed when dropped).
+pub fn temp_dir() -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix("brtf-cli-test")
+        .tempdir()
+        .expect("create temp dir")
+}
+
+/// Writes `text` to `dir/name` and returns the path.
+pub fn write_file(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap_or_else(|e| panic!("write {}: {e}", path.display()));
+    path
+}
+
+/// A path as a `&str` (temp dirs and the repo are UTF-8 here).
+pub fn s(path: &Path) -> &str {
+    path.to_str().expect("UTF-8 path")
+}
+
+/// Path of a file under the repository root.
+pub fn repo_path(relative: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(relative)
+}
+
+/// Path of a file in `tests/cli/data`.
+pub fn data_path(name: &str) -> PathBuf {
+    repo_path("tests/cli/data").join(name)
+}
+
+/// Unit vector (θ, φ in degrees), z = surface normal.
+pub fn direction(theta_deg: f64, phi_deg: f64) -> [f64; 3] {
+    let (st, ct) = theta_deg.to_radians().sin_cos();
+    let (sp, cp) = phi_deg.to_radians().sin_cos();
+    [st * cp, st * sp, ct]
+}
+
+/// Solid angle of a cone with full apex angle `apex_deg`: 2π(1 − cos(A/2)).
+pub fn cone_solid_angle(apex_deg: f64) -> f64 {
+    2.0 * std::f64::consts::PI * (1.0 - (apex_deg.to_radians() / 2.0).cos())
+}
+
+/// `|a − b| ≤ abs` or `≤ rel·|b|`.
+pub fn close(a: f64, b: f64, rel: f64, abs: f64) -> bool {
+    let d = (a - b).abs();
+    d <= abs || d <= rel * b.abs()
+}
