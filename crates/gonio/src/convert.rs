@@ -47,9 +47,8 @@ impl Measurement {
                 unit,
                 beam_integral,
             } => {
-                let beam = beam_integral.ok_or_else(|| ConvertError::MissingBeamIntegral {
-                    unit: unit.clone(),
-                })?;
+                let beam = beam_integral
+                    .ok_or_else(|| ConvertError::MissingBeamIntegral { unit: unit.clone() })?;
                 self.raw_to_dsf(beam)
             }
         }
@@ -65,9 +64,8 @@ impl Measurement {
                 unit,
                 beam_integral,
             } => {
-                let beam = beam_integral.ok_or_else(|| ConvertError::MissingBeamIntegral {
-                    unit: unit.clone(),
-                })?;
+                let beam = beam_integral
+                    .ok_or_else(|| ConvertError::MissingBeamIntegral { unit: unit.clone() })?;
                 self.raw_to_bsdf(beam)
             }
         }

@@ -183,7 +183,9 @@ pub enum ParseErrorKind {
         found: usize,
     },
     /// A header line follows the first data row.
-    #[error("header line after the first data row (line {first_data_line}); headers must come first")]
+    #[error(
+        "header line after the first data row (line {first_data_line}); headers must come first"
+    )]
     HeaderAfterData {
         /// Line of the first data row.
         first_data_line: usize,

@@ -75,7 +75,7 @@ pub fn hemispherical_integral(
         value += v * cos * w;
         used += 1;
     }
-    (used + skipped > 0).then(|| HemisphereIntegral {
+    (used + skipped > 0).then_some(HemisphereIntegral {
         hemisphere,
         value: value * scale,
         unit,

@@ -64,10 +64,7 @@ pub struct Incidence {
 impl Incidence {
     /// An incidence from θ_in and φ_in in degrees (stored as given).
     pub fn new(theta_deg: f64, phi_deg: f64) -> Self {
-        Self {
-            theta_deg,
-            phi_deg,
-        }
+        Self { theta_deg, phi_deg }
     }
 
     /// Unit vector towards the light source, z = front normal.

@@ -279,7 +279,10 @@ fn circumcenter(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> [f64; 2] {
     let b2 = bx * bx + by * by;
     let c2 = cx * cx + cy * cy;
     let d = 2.0 * (bx * cy - by * cx);
-    [a[0] + (cy * b2 - by * c2) / d, a[1] + (bx * c2 - cx * b2) / d]
+    [
+        a[0] + (cy * b2 - by * c2) / d,
+        a[1] + (bx * c2 - cx * b2) / d,
+    ]
 }
 
 /// Signed area of `polygon ∩ disk(0, radius)` (positive for
@@ -295,7 +298,7 @@ pub fn disk_polygon_area(polygon: &[[f64; 2]], radius: f64) -> f64 {
 fn disk_triangle_area(a: [f64; 2], b: [f64; 2], r: f64) -> f64 {
     let d = [b[0] - a[0], b[1] - a[1]];
     let qa = d[0] * d[0] + d[1] * d[1];
-    if !(qa > 0.0) || !qa.is_finite() {
+    if qa.is_nan() || qa <= 0.0 || qa.is_infinite() {
         return 0.0;
     }
     let qb = a[0] * d[0] + a[1] * d[1];

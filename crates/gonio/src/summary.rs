@@ -224,7 +224,11 @@ impl fmt::Display for Summary {
             self.channels.colorimetry_name()
         )?;
         if let Some(beam) = &self.beam {
-            writeln!(f, "  beam file     {} (integral {})", beam.file, beam.integral)?;
+            writeln!(
+                f,
+                "  beam file     {} (integral {})",
+                beam.file, beam.integral
+            )?;
         }
         writeln!(
             f,

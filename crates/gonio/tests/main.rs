@@ -1,1 +1,17 @@
-//! Integration tests for brtf-gonio.
+//! Integration tests for brtf-gonio: one binary, one module per source
+//! module (plus `common` helpers and `robustness` fuzzing).
+//!
+//! Real pgII scans are read from `../shared/data/rgl-epfl-pgII-raw/` beside
+//! the repository; the tests fail (never skip) when they are missing.
+
+mod common;
+
+mod convert;
+mod integral;
+mod measurement;
+mod read;
+mod robustness;
+mod select;
+mod solid_angle;
+mod summary;
+mod write;

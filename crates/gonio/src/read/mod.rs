@@ -63,10 +63,11 @@ pub fn read_bytes_as(
     }
 }
 
-/// Guesses the format: a `.mpc` extension, then telltale header lines
-/// (`#format:` for Mountain; `#using beam file`, `#incident angle` or an
-/// eight-column `#theta phi beam-ref …` line for `.mpc`), then the column
-/// count of the first data row (8 means `.mpc`). Defaults to Mountain.
+/// Guesses the format: a `.mpc` extension; else the header (a `#format:`
+/// or `#intheta` line means Mountain, which `.mpc` files never have; a
+/// `#using beam file`, `#incident angle …` or `#theta phi beam-ref …` line
+/// means `.mpc`); else the column count of the first data row (8 means
+/// `.mpc`). Defaults to Mountain.
 pub fn detect_format(bytes: &[u8], name: &Path) -> SourceFormat {
     let has_mpc_extension = name
         .extension()
@@ -77,6 +78,7 @@ pub fn detect_format(bytes: &[u8], name: &Path) -> SourceFormat {
     // Only the head of the file matters; invalid UTF-8 is reported later.
     let head = &bytes[..bytes.len().min(64 * 1024)];
     let head = String::from_utf8_lossy(head);
+    let mut mpc_marker = false;
     for line in head.lines() {
         let line = line.trim();
         if line.is_empty() {
@@ -87,21 +89,26 @@ pub fn detect_format(bytes: &[u8], name: &Path) -> SourceFormat {
             if body.starts_with("format:") || body.starts_with("intheta") {
                 return SourceFormat::Mountain;
             }
-            if body.starts_with("using beam file")
+            mpc_marker |= body.starts_with("using beam file")
                 || body.starts_with("incident angle")
-                || body.starts_with("theta phi beam-ref")
-            {
-                return SourceFormat::Mpc;
-            }
-        } else if line.split_ascii_whitespace().count() >= 2 {
-            return if line.split_ascii_whitespace().count() == mpc::COLUMNS {
-                SourceFormat::Mpc
-            } else {
-                SourceFormat::Mountain
-            };
+                || body.starts_with("theta phi beam-ref");
+            continue;
         }
+        let columns = line.split_ascii_whitespace().count();
+        if columns < 2 {
+            continue; // an `.mpc` bare header value
+        }
+        return if mpc_marker || columns == mpc::COLUMNS {
+            SourceFormat::Mpc
+        } else {
+            SourceFormat::Mountain
+        };
     }
-    SourceFormat::Mountain
+    if mpc_marker {
+        SourceFormat::Mpc
+    } else {
+        SourceFormat::Mountain
+    }
 }
 
 fn read_file(path: &Path) -> Result<Vec<u8>, ReadError> {
@@ -222,11 +229,13 @@ impl<'a> Row<'a> {
         let field = &self.line[start..end];
         match parse_number(field, column, name) {
             Ok(value) if !field.is_empty() => Ok(value),
-            Ok(_) => Err(self.column_count_error().unwrap_or(ParseErrorKind::NotANumber {
-                column,
-                name,
-                text: String::new(),
-            })),
+            Ok(_) => Err(self
+                .column_count_error()
+                .unwrap_or(ParseErrorKind::NotANumber {
+                    column,
+                    name,
+                    text: String::new(),
+                })),
             Err(kind) => Err(self.column_count_error().unwrap_or(kind)),
         }
     }
@@ -234,7 +243,11 @@ impl<'a> Row<'a> {
     /// The next field as a value: like [`Row::number`], but the
     /// `9.9e+37` sentinel becomes NaN.
     #[inline]
-    pub(crate) fn value(&mut self, column: usize, name: &'static str) -> Result<f64, ParseErrorKind> {
+    pub(crate) fn value(
+        &mut self,
+        column: usize,
+        name: &'static str,
+    ) -> Result<f64, ParseErrorKind> {
         let v = self.number(column, name)?;
         Ok(if v.abs() >= SENTINEL_THRESHOLD {
             f64::NAN
@@ -258,11 +271,13 @@ impl<'a> Row<'a> {
         if rest.iter().all(u8::is_ascii_whitespace) {
             Ok(())
         } else {
-            Err(self.column_count_error().unwrap_or(ParseErrorKind::ColumnCount {
-                expected: self.expected,
-                found: self.expected + 1,
-                layout: self.layout,
-            }))
+            Err(self
+                .column_count_error()
+                .unwrap_or(ParseErrorKind::ColumnCount {
+                    expected: self.expected,
+                    found: self.expected + 1,
+                    layout: self.layout,
+                }))
         }
     }
 }
@@ -340,7 +355,9 @@ pub fn incidence_from_file_name(name: &Path) -> Option<(f64, f64)> {
     let stem = match file_name.rfind('.') {
         Some(dot)
             if dot + 1 < file_name.len()
-                && file_name[dot + 1..].bytes().all(|b| b.is_ascii_alphabetic()) =>
+                && file_name[dot + 1..]
+                    .bytes()
+                    .all(|b| b.is_ascii_alphabetic()) =>
         {
             &file_name[..dot]
         }
@@ -428,9 +445,7 @@ pub(crate) fn resolve_incidence(
     if let Some((name_theta, name_phi)) = from_name
         && !same_incidence((theta, phi), (name_theta, name_phi))
     {
-        let conflict_line = header_theta
-            .or(header_phi)
-            .map_or(line, |angle| angle.line);
+        let conflict_line = header_theta.or(header_phi).map_or(line, |angle| angle.line);
         let kind = ParseErrorKind::IncidenceConflict {
             header_theta: theta,
             header_phi: phi,

@@ -201,7 +201,11 @@ pub(crate) fn parse(text: &str, name: &Path) -> Result<Measurement, ReadError> {
     let (incidence, incidence_origin) =
         resolve_incidence(theta_in, phi_in, name, first_data_line, INCIDENCE_KEYS)?;
     let Some(mut quantity) = quantity else {
-        return Err(parse_error(name, first_data_line, ParseErrorKind::MissingFormat));
+        return Err(parse_error(
+            name,
+            first_data_line,
+            ParseErrorKind::MissingFormat,
+        ));
     };
     if let Quantity::Raw {
         beam_integral: slot,
@@ -211,8 +215,13 @@ pub(crate) fn parse(text: &str, name: &Path) -> Result<Measurement, ReadError> {
         *slot = beam_integral;
     }
 
-    let mut measurement =
-        Measurement::new(SourceFormat::Mountain, incidence, quantity, channels, samples);
+    let mut measurement = Measurement::new(
+        SourceFormat::Mountain,
+        incidence,
+        quantity,
+        channels,
+        samples,
+    );
     measurement.incidence_origin = incidence_origin;
     measurement.sample_name = sample_name;
     measurement.up_phi_deg = up_phi;
@@ -284,8 +293,14 @@ mod tests {
                 beam_integral: None
             })
         );
-        assert_eq!(parse_format_quantity("theta phi BRDF"), Some(Quantity::Bsdf));
-        assert_eq!(parse_format_quantity("theta phi DSF DSF DSF"), Some(Quantity::Dsf));
+        assert_eq!(
+            parse_format_quantity("theta phi BRDF"),
+            Some(Quantity::Bsdf)
+        );
+        assert_eq!(
+            parse_format_quantity("theta phi DSF DSF DSF"),
+            Some(Quantity::Dsf)
+        );
         assert_eq!(parse_format_quantity("theta phi"), None);
         assert_eq!(parse_format_quantity("theta phi lux"), None);
         assert_eq!(parse_colorimetry("CIE-XYZ"), Some(Channels::Xyz));

@@ -196,10 +196,7 @@ fn parse_beam(body: &str, name: &Path, line: usize) -> Result<BeamReference, Rea
         };
         parse_error(name, line, kind)
     };
-    let rest = body
-        .split_once(':')
-        .map_or("", |(_, rest)| rest)
-        .trim();
+    let rest = body.split_once(':').map_or("", |(_, rest)| rest).trim();
     let Some((file, value)) = rest.rsplit_once(|c: char| c.is_ascii_whitespace()) else {
         return Err(bad(rest));
     };

@@ -79,11 +79,17 @@ fn header_lines(m: &Measurement) -> Vec<String> {
         let new_line = match key.as_str() {
             "intheta" => {
                 wrote_theta = true;
-                keep_if(first_number(rest) == Some(theta), number_line("intheta", &[theta]))
+                keep_if(
+                    first_number(rest) == Some(theta),
+                    number_line("intheta", &[theta]),
+                )
             }
             "inphi" => {
                 wrote_phi = true;
-                keep_if(first_number(rest) == Some(phi), number_line("inphi", &[phi]))
+                keep_if(
+                    first_number(rest) == Some(phi),
+                    number_line("inphi", &[phi]),
+                )
             }
             "incident_angle" => {
                 wrote_theta = true;
@@ -121,13 +127,19 @@ fn header_lines(m: &Measurement) -> Vec<String> {
             }
             "datapoints_in_file" => {
                 wrote_count = true;
-                let count = rest.split_ascii_whitespace().next().map(str::parse::<usize>);
+                let count = rest
+                    .split_ascii_whitespace()
+                    .next()
+                    .map(str::parse::<usize>);
                 keep_if(count == Some(Ok(m.samples.len())), count_line(m))
             }
             BEAM_INTEGRAL_KEY => {
                 wrote_beam = true;
                 match beam_integral {
-                    Some(b) => keep_if(first_number(rest) == Some(b), number_line(BEAM_INTEGRAL_KEY, &[b])),
+                    Some(b) => keep_if(
+                        first_number(rest) == Some(b),
+                        number_line(BEAM_INTEGRAL_KEY, &[b]),
+                    ),
                     None => continue,
                 }
             }
