@@ -22,7 +22,10 @@ fn direction_pairs() -> Vec<(DVec3, DVec3)> {
         .map(|i| {
             let (ti, pi) = (80.0 * uniform(), 360.0 * uniform());
             let v = if i % 4 == 0 {
-                direction(ti + 5.0 * (uniform() - 0.5), pi + 180.0 + 10.0 * (uniform() - 0.5))
+                direction(
+                    ti + 5.0 * (uniform() - 0.5),
+                    pi + 180.0 + 10.0 * (uniform() - 0.5),
+                )
             } else {
                 direction(179.0 * uniform(), 360.0 * uniform())
             };

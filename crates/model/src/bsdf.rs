@@ -10,6 +10,8 @@
 //! towards the viewer. `v.z < 0` is the back side; like rtrace, the
 //! surface is turned towards the viewer, so every material is two-sided.
 
+#![allow(clippy::needless_range_loop)] // channel loops index several arrays at once
+
 use crate::kind::{ArgLayout, MaterialKind, Variant};
 use crate::material::{FTINY, MAX_ARGS, Material};
 use crate::options::EvalOptions;
@@ -93,9 +95,7 @@ impl Bsdf {
         let variant = options.variant;
         let omega = options.source_omega.max(0.0);
         let reflect_widening = match variant {
-            Variant::Radiance if options.flat => {
-                (1.0 - options.source_jitter) * omega / (4.0 * PI)
-            }
+            Variant::Radiance if options.flat => (1.0 - options.source_jitter) * omega / (4.0 * PI),
             Variant::Radiance => 0.0,
             Variant::Manual2004 => omega / (4.0 * PI),
             Variant::Ward1992 if options.flat => omega / (4.0 * PI),
@@ -279,7 +279,16 @@ impl Bsdf {
         let lay = self.layout;
         let c = self.color;
         if light_cosine > FTINY {
-            self.add_reflection::<GRAD>(l, v, light_cosine, view_cosine, &view, light_fresnel, &mut f, grad);
+            self.add_reflection::<GRAD>(
+                l,
+                v,
+                light_cosine,
+                view_cosine,
+                &view,
+                light_fresnel,
+                &mut f,
+                grad,
+            );
         } else if light_cosine < -FTINY {
             // Diffuse transmission C·Td/π.
             // (td > 0 only for the transmitting types, which have both indices.)
@@ -292,14 +301,24 @@ impl Bsdf {
                     let g = light_fresnel / PI;
                     for ch in 0..3 {
                         grad.d[ch][ch] += k;
-                        grad.d[3][ch] += c[ch] * g * (-self.trans * (1.0 - self.tspec) * view.dspec);
+                        grad.d[3][ch] +=
+                            c[ch] * g * (-self.trans * (1.0 - self.tspec) * view.dspec);
                         grad.d[it][ch] += c[ch] * g * (1.0 - view.spec) * (1.0 - self.tspec);
                         grad.d[is][ch] += c[ch] * g * (-self.trans * (1.0 - view.spec));
                     }
                 }
             }
             if !self.pure && ts > FTINY {
-                self.add_transmission::<GRAD>(l, v, -light_cosine, view_cosine, &view, ts, &mut f, grad);
+                self.add_transmission::<GRAD>(
+                    l,
+                    v,
+                    -light_cosine,
+                    view_cosine,
+                    &view,
+                    ts,
+                    &mut f,
+                    grad,
+                );
             }
         }
         f

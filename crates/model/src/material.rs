@@ -42,10 +42,7 @@ impl fmt::Display for ModelError {
                 kind,
                 expected,
                 found,
-            } => write!(
-                f,
-                "{kind} takes {expected} real arguments, found {found}"
-            ),
+            } => write!(f, "{kind} takes {expected} real arguments, found {found}"),
             ModelError::NonFinite { index } => {
                 write!(f, "real argument {} is not a finite number", index + 1)
             }

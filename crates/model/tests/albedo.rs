@@ -35,7 +35,11 @@ proptest! {
 #[test]
 fn lambertian_albedo_is_exact() {
     let m = Material::new(MaterialKind::Plastic, &[0.2, 0.5, 0.8, 0.0, 0.0], None).unwrap();
-    let a = albedo(&Bsdf::new(&m, &EvalOptions::default()), direction(40.0, 0.0), 1e-6);
+    let a = albedo(
+        &Bsdf::new(&m, &EvalOptions::default()),
+        direction(40.0, 0.0),
+        1e-6,
+    );
     for (got, want) in a.rho.iter().zip([0.2, 0.5, 0.8]) {
         assert!((got - want).abs() < 1e-9, "{got} vs {want}");
     }
@@ -55,16 +59,32 @@ fn historical_variants_reproduce_the_spec_albedo_table() {
         let bsdf = Bsdf::new(&m, &EvalOptions::with_variant(variant));
         for (theta, want) in [0.0, 45.0, 75.0, 85.0].into_iter().zip(expected) {
             let got = albedo(&bsdf, direction(theta, 0.0), 1e-6).rho[0];
-            assert!((got - want).abs() < 1.5e-3, "{variant} θi={theta}: {got} vs {want}");
+            assert!(
+                (got - want).abs() < 1.5e-3,
+                "{variant} θi={theta}: {got} vs {want}"
+            );
         }
     }
 }
 
 #[test]
 fn roughness_zero_spikes_are_reported_separately() {
-    let m = Material::new(MaterialKind::Trans, &[0.8, 0.8, 0.8, 0.05, 0.0, 0.5, 0.6], None).unwrap();
-    let a = albedo(&Bsdf::new(&m, &EvalOptions::default()), direction(30.0, 0.0), 1e-6);
-    assert!(a.rho_spike[0] > 0.05 && a.rho_spike[0] < 0.1, "{:?}", a.rho_spike);
+    let m = Material::new(
+        MaterialKind::Trans,
+        &[0.8, 0.8, 0.8, 0.05, 0.0, 0.5, 0.6],
+        None,
+    )
+    .unwrap();
+    let a = albedo(
+        &Bsdf::new(&m, &EvalOptions::default()),
+        direction(30.0, 0.0),
+        1e-6,
+    );
+    assert!(
+        a.rho_spike[0] > 0.05 && a.rho_spike[0] < 0.1,
+        "{:?}",
+        a.rho_spike
+    );
     assert!(a.tau_spike[0] > 0.2, "{:?}", a.tau_spike);
     let total = a.rho[0] + a.tau[0] + a.rho_spike[0] + a.tau_spike[0];
     assert!(total <= 1.0 + 1e-3);

@@ -128,10 +128,17 @@ fn variants_agree_at_the_mirror_peak_and_differ_elsewhere() {
     let manual = Bsdf::new(&m, &EvalOptions::with_variant(Variant::Manual2004));
     let l = direction(45.0, 0.0);
     let mirror = direction(45.0, 180.0);
-    assert_relative_eq!(radiance.eval(l, mirror)[0], manual.eval(l, mirror)[0], max_relative = 1e-12);
+    assert_relative_eq!(
+        radiance.eval(l, mirror)[0],
+        manual.eval(l, mirror)[0],
+        max_relative = 1e-12
+    );
     let off = direction(55.0, 170.0);
     let (a, b) = (radiance.eval(l, off)[0], manual.eval(l, off)[0]);
-    assert!((a - b).abs() > 1e-3 * a, "variants should differ off-peak: {a} vs {b}");
+    assert!(
+        (a - b).abs() > 1e-3 * a,
+        "variants should differ off-peak: {a} vs {b}"
+    );
 }
 
 #[test]

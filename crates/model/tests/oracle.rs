@@ -9,7 +9,9 @@ use glam::DVec3;
 use std::path::PathBuf;
 
 fn data(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/oracle").join(name)
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/oracle")
+        .join(name)
 }
 
 /// The tables were made with a 0.01° source, a flat polygon, `-dj 0`,
@@ -24,11 +26,17 @@ fn oracle_options() -> EvalOptions {
 
 fn parse_material(kind: &str, args: &str, orient: &str) -> Material {
     let kind: MaterialKind = kind.parse().unwrap();
-    let args: Vec<f64> = args.split_whitespace().map(|a| a.parse().unwrap()).collect();
+    let args: Vec<f64> = args
+        .split_whitespace()
+        .map(|a| a.parse().unwrap())
+        .collect();
     let orient = if orient.trim().is_empty() {
         None
     } else {
-        let o: Vec<f64> = orient.split_whitespace().map(|a| a.parse().unwrap()).collect();
+        let o: Vec<f64> = orient
+            .split_whitespace()
+            .map(|a| a.parse().unwrap())
+            .collect();
         Some(DVec3::new(o[0], o[1], o[2]))
     };
     Material::new(kind, &args, orient).unwrap()
@@ -117,7 +125,10 @@ fn hemispherical_integrals_match_rtrace() {
                 assert!(
                     err <= 2e-4,
                     "{} set {} θi={} φi={} {what}[{ch}]: brtf {got} vs rtrace {want}",
-                    &r[0], &r[1], &r[4], &r[5]
+                    &r[0],
+                    &r[1],
+                    &r[4],
+                    &r[5]
                 );
             }
         }

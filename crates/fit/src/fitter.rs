@@ -1,0 +1,838 @@
+//! Per-incidence and all-incidence fits: data checks, data-driven starting
+//! values, a multi-start over roughness on a subsample, the final
+//! Levenberg-Marquardt fit on every sample, optional robust reweighting,
+//! and standard errors from s²(JᵀJ)⁻¹.
+
+use crate::data::{GateReport, IncidenceData};
+use crate::params::{MIN_ROUGHNESS, ParamMap, Target};
+use crate::problem::{Block, Problem, ResidualKind};
+use brtf_model::{EvalOptions, MaterialKind};
+use glam::DVec3;
+use levenberg_marquardt::{LevenbergMarquardt, TerminationReason};
+use nalgebra::DVector;
+use serde::{Deserialize, Serialize};
+use std::cell::Cell;
+use std::f64::consts::PI;
+use std::time::Instant;
+
+/// Robust loss, applied by iteratively reweighting the residuals.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+pub enum RobustLoss {
+    /// Plain least squares.
+    #[default]
+    None,
+    /// Huber with threshold `c` in robust standard deviations.
+    Huber(f64),
+    /// Cauchy with scale `c` in robust standard deviations.
+    Cauchy(f64),
+}
+
+/// Everything that decides a fit.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FitConfig {
+    /// The model.
+    #[serde(with = "crate::serde_kind")]
+    pub kind: MaterialKind,
+    /// Variant, Fresnel constant and source size of the model.
+    #[serde(with = "options_serde")]
+    pub options: EvalOptions,
+    /// Orientation vector of the `*2` types.
+    pub orientation: [f64; 3],
+    /// Tie R = G = B.
+    pub gray: bool,
+    /// Fit a free overall scale (raw-signal data of unknown scale).
+    pub free_scale: bool,
+    /// How model and data are compared.
+    pub residual: ResidualKind,
+    /// Floor (same unit as the data) for relative and log residuals;
+    /// `None` picks 10% of the data's 10th percentile.
+    pub floor: Option<f64>,
+    /// Robust loss.
+    pub loss: RobustLoss,
+    /// Try several starting roughnesses and keep the best.
+    pub multistart: bool,
+}
+
+impl FitConfig {
+    /// Defaults for `kind`: radiance variant, RGB, relative residuals, multi-start.
+    pub fn new(kind: MaterialKind) -> FitConfig {
+        FitConfig {
+            kind,
+            options: EvalOptions::default(),
+            orientation: [1.0, 0.0, 0.0],
+            gray: false,
+            free_scale: false,
+            residual: ResidualKind::Relative,
+            floor: None,
+            loss: RobustLoss::None,
+            multistart: true,
+        }
+    }
+}
+
+mod options_serde {
+    use brtf_model::{EvalOptions, Variant};
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    #[derive(Serialize, Deserialize)]
+    struct Options {
+        variant: String,
+        fresnel_k: f64,
+        source_omega: f64,
+        flat: bool,
+        source_jitter: f64,
+    }
+
+    pub fn serialize<S: Serializer>(o: &EvalOptions, s: S) -> Result<S::Ok, S::Error> {
+        Options {
+            variant: o.variant.name().into(),
+            fresnel_k: o.fresnel_k,
+            source_omega: o.source_omega,
+            flat: o.flat,
+            source_jitter: o.source_jitter,
+        }
+        .serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<EvalOptions, D::Error> {
+        let o = Options::deserialize(d)?;
+        let variant: Variant = o.variant.parse().map_err(serde::de::Error::custom)?;
+        Ok(EvalOptions {
+            variant,
+            fresnel_k: o.fresnel_k,
+            source_omega: o.source_omega,
+            flat: o.flat,
+            source_jitter: o.source_jitter,
+        })
+    }
+}
+
+/// Why a fit could not run.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum FitError {
+    /// No samples are left after the selections.
+    #[error("{origin}: no samples left to fit after the selections ({gates})")]
+    EmptySelection {
+        /// The data's origin.
+        origin: String,
+        /// The selections applied.
+        gates: String,
+    },
+    /// Every value is zero or negative.
+    #[error("{origin}: all {count} values are zero or negative; nothing to fit")]
+    AllZero {
+        /// The data's origin.
+        origin: String,
+        /// How many samples.
+        count: usize,
+    },
+    /// A value is NaN or infinite.
+    #[error("{origin}: sample {index} has a non-finite value or weight")]
+    NonFinite {
+        /// The data's origin.
+        origin: String,
+        /// Sample index.
+        index: usize,
+    },
+    /// A transmitting model needs back-hemisphere data.
+    #[error("{origin}: a {kind} fit needs transmission data (back hemisphere), found none")]
+    NoTransmission {
+        /// The data's origin.
+        origin: String,
+        /// The model.
+        kind: MaterialKind,
+    },
+    /// Incidences differ in channel count.
+    #[error("incidences mix single-channel and RGB data")]
+    MixedChannels,
+    /// The optimiser failed at the start.
+    #[error("{origin}: the fit could not start: {reason}")]
+    Failed {
+        /// The data's origin.
+        origin: String,
+        /// What went wrong.
+        reason: String,
+    },
+}
+
+/// Why the optimiser stopped (from the levenberg-marquardt crate).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum Termination {
+    /// Relative reduction of the cost (ftol) or step (xtol) below tolerance.
+    Converged {
+        /// ftol criterion met.
+        ftol: bool,
+        /// xtol criterion met.
+        xtol: bool,
+    },
+    /// Residuals orthogonal to the Jacobian (gtol).
+    Orthogonal,
+    /// Residuals exactly zero.
+    ResidualsZero,
+    /// Evaluation budget exhausted.
+    LostPatience,
+    /// Tolerances too tight for floating point.
+    NoImprovementPossible(String),
+    /// NaN or infinity met.
+    Numerical(String),
+    /// Anything else.
+    Other(String),
+}
+
+impl Termination {
+    fn from_lm(reason: &TerminationReason) -> Termination {
+        match reason {
+            TerminationReason::Converged { ftol, xtol } => Termination::Converged {
+                ftol: *ftol,
+                xtol: *xtol,
+            },
+            TerminationReason::Orthogonal => Termination::Orthogonal,
+            TerminationReason::ResidualsZero => Termination::ResidualsZero,
+            TerminationReason::LostPatience => Termination::LostPatience,
+            TerminationReason::NoImprovementPossible(s) => {
+                Termination::NoImprovementPossible((*s).into())
+            }
+            TerminationReason::Numerical(s) => Termination::Numerical((*s).into()),
+            other => Termination::Other(format!("{other:?}")),
+        }
+    }
+
+    /// The optimiser reached a stationary point (not a judgement of physics).
+    pub fn converged(&self) -> bool {
+        matches!(
+            self,
+            Termination::Converged { .. }
+                | Termination::Orthogonal
+                | Termination::ResidualsZero
+                | Termination::NoImprovementPossible(_)
+        )
+    }
+
+    /// A short label for tables.
+    pub fn label(&self) -> &'static str {
+        match self {
+            Termination::Converged { .. } => "converged",
+            Termination::Orthogonal => "orthogonal",
+            Termination::ResidualsZero => "residuals_zero",
+            Termination::LostPatience => "lost_patience",
+            Termination::NoImprovementPossible(_) => "no_improvement_possible",
+            Termination::Numerical(_) => "numerical",
+            Termination::Other(_) => "other",
+        }
+    }
+}
+
+/// One fitted parameter.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ParamEstimate {
+    /// Name (`red`, `spec`, `rough`, `scale`, ...).
+    pub name: String,
+    /// Fitted value.
+    pub value: f64,
+    /// Standard error from s²(JᵀJ)⁻¹ (0 for a parameter held fixed).
+    pub stderr: f64,
+    /// Ended at a physical bound (its standard error is then meaningless).
+    pub at_bound: bool,
+    /// Held fixed rather than fitted.
+    pub fixed: bool,
+}
+
+/// One starting point of the multi-start and where it ended.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StartRecord {
+    /// Starting roughness (u, v).
+    pub rough: [f64; 2],
+    /// Cost reached on the subsample.
+    pub cost: f64,
+}
+
+/// The result of fitting one incidence (or all at once).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FitReport {
+    /// Where the data came from.
+    pub source: String,
+    /// Incident polar angle in degrees (NaN-free; 0 for the global fit).
+    pub theta_in: f64,
+    /// Incident azimuth in degrees.
+    pub phi_in: f64,
+    /// Every material argument by name, then `scale` when free.
+    pub params: Vec<ParamEstimate>,
+    /// The fitted material's real arguments, in Radiance order.
+    pub material_args: Vec<f64>,
+    /// Free scale (1 when not fitted).
+    pub scale: f64,
+    /// Samples used.
+    pub n_points: usize,
+    /// Selections applied before the fit.
+    pub gates: Vec<GateReport>,
+    /// Which weights were used.
+    pub weighting: String,
+    /// RMS of `(m − y)/sqrt(y² + floor²)` over all samples and channels.
+    pub rms_rel: f64,
+    /// ½ Σ r² at the solution (the optimiser's objective).
+    pub cost: f64,
+    /// The floor used by relative/log residuals.
+    pub floor: f64,
+    /// Why the optimiser stopped.
+    pub termination: Termination,
+    /// Residual + Jacobian evaluations over all starts and passes.
+    pub evaluations: usize,
+    /// Wall time in milliseconds.
+    pub elapsed_ms: f64,
+    /// The multi-start record.
+    pub starts: Vec<StartRecord>,
+    /// Things the user should know (bounds, degenerate lobes, ...).
+    pub warnings: Vec<String>,
+}
+
+impl FitReport {
+    /// Value of the parameter called `name`.
+    pub fn value(&self, name: &str) -> Option<f64> {
+        self.params.iter().find(|p| p.name == name).map(|p| p.value)
+    }
+
+    /// Standard error of the parameter called `name`.
+    pub fn stderr(&self, name: &str) -> Option<f64> {
+        self.params
+            .iter()
+            .find(|p| p.name == name)
+            .map(|p| p.stderr)
+    }
+}
+
+/// Samples per start in the multi-start phase.
+const SUBSAMPLE: usize = 3000;
+
+/// Fits one incidence.
+pub fn fit_incidence(data: &IncidenceData, config: &FitConfig) -> Result<FitReport, FitError> {
+    fit_many(std::slice::from_ref(data), config, &data.source)
+}
+
+/// Fits one parameter set to all incidences at once. Each incidence gets
+/// the same total weight, so densely sampled files do not dominate.
+pub fn fit_global(data: &[IncidenceData], config: &FitConfig) -> Result<FitReport, FitError> {
+    fit_many(data, config, "all incidences")
+}
+
+fn validate(data: &IncidenceData, config: &FitConfig) -> Result<(), FitError> {
+    if data.samples.is_empty() {
+        let gates: Vec<String> = data
+            .gates
+            .iter()
+            .map(|g| format!("{} removed {}", g.gate, g.removed))
+            .collect();
+        return Err(FitError::EmptySelection {
+            origin: data.source.clone(),
+            gates: if gates.is_empty() {
+                "none".into()
+            } else {
+                gates.join(", ")
+            },
+        });
+    }
+    let channels = data.channels.clamp(1, 3);
+    for (index, s) in data.samples.iter().enumerate() {
+        if !s.weight.is_finite() || s.value[..channels].iter().any(|v| !v.is_finite()) {
+            return Err(FitError::NonFinite {
+                origin: data.source.clone(),
+                index,
+            });
+        }
+    }
+    if data
+        .samples
+        .iter()
+        .all(|s| s.value[..channels].iter().all(|&v| v <= 0.0))
+    {
+        return Err(FitError::AllZero {
+            origin: data.source.clone(),
+            count: data.samples.len(),
+        });
+    }
+    if config.kind.is_transmitting() && data.samples.iter().all(|s| s.view.z >= 0.0) {
+        return Err(FitError::NoTransmission {
+            origin: data.source.clone(),
+            kind: config.kind,
+        });
+    }
+    Ok(())
+}
+
+fn fit_many(
+    data: &[IncidenceData],
+    config: &FitConfig,
+    label: &str,
+) -> Result<FitReport, FitError> {
+    let started = Instant::now();
+    for d in data {
+        validate(d, config)?;
+    }
+    let channels = data[0].channels.clamp(1, 3);
+    if data.iter().any(|d| d.channels.clamp(1, 3) != channels) {
+        return Err(FitError::MixedChannels);
+    }
+    let gray = config.gray || channels == 1;
+    let map = ParamMap::new(config.kind, gray, config.free_scale);
+    let orientation = DVec3::from_array(config.orientation);
+    let floor = config.floor.unwrap_or_else(|| auto_floor(data, channels));
+    let mut blocks: Vec<Block> = data.iter().map(|d| make_block(d, data.len() > 1)).collect();
+    for b in &mut blocks {
+        b.set_factors(config.residual, floor);
+    }
+    let n_points: usize = blocks.iter().map(Block::len).sum();
+    let evaluations = Cell::new(0usize);
+    let solve = |blocks: &[Block], u0: DVector<f64>, patience: usize| {
+        let problem = Problem {
+            map: &map,
+            options: config.options,
+            orientation,
+            blocks,
+            channels,
+            kind: config.residual,
+            floor,
+            u: u0.clone(),
+            evaluations: Cell::new(0),
+        };
+        let (problem, report) = LevenbergMarquardt::new()
+            .with_ftol(1e-12)
+            .with_xtol(1e-12)
+            .with_gtol(1e-14)
+            .with_patience(patience)
+            .minimize(problem);
+        evaluations.set(evaluations.get() + problem.evaluations.get());
+        // After User/Numerical stops the problem holds the rejected trial
+        // point; fall back to the start then.
+        let u = if matches!(
+            report.termination,
+            TerminationReason::User(_) | TerminationReason::Numerical(_)
+        ) {
+            u0
+        } else {
+            problem.u.clone()
+        };
+        let cost = problem
+            .residual_vector(&u)
+            .map_or(f64::INFINITY, |r| 0.5 * r.norm_squared());
+        (u, cost, report.termination)
+    };
+
+    // Multi-start on a subsample, then the full fit from the best start.
+    let starts = starting_points(data, &map, config, channels);
+    let mut records = Vec::new();
+    let mut best: Option<(DVector<f64>, f64)> = None;
+    if starts.len() > 1 {
+        let sub: Vec<Block> = blocks
+            .iter()
+            .map(|b| subsample(b, SUBSAMPLE / blocks.len().max(1)))
+            .collect();
+        for (rough, u0) in &starts {
+            let (u, cost, _) = solve(&sub, u0.clone(), 60);
+            records.push(StartRecord {
+                rough: *rough,
+                cost,
+            });
+            if best.as_ref().is_none_or(|(_, c)| cost < *c) {
+                best = Some((u, cost));
+            }
+        }
+    }
+    let u_start = best.map_or_else(|| starts[0].1.clone(), |(u, _)| u);
+    let (mut u, mut cost, mut termination) = solve(&blocks, u_start, 200);
+    if !cost.is_finite() {
+        return Err(FitError::Failed {
+            origin: label.into(),
+            reason: format!("no finite residuals ({termination:?})"),
+        });
+    }
+
+    // Robust loss by iteratively reweighted least squares.
+    if config.loss != RobustLoss::None {
+        let base = blocks.clone();
+        for _ in 0..5 {
+            let problem = Problem {
+                map: &map,
+                options: config.options,
+                orientation,
+                blocks: &base,
+                channels,
+                kind: config.residual,
+                floor,
+                u: u.clone(),
+                evaluations: Cell::new(0),
+            };
+            let Some(r) = problem.residual_vector(&u) else {
+                break;
+            };
+            let sigma = robust_sigma(&r);
+            let mut row = 0;
+            for (b, orig) in blocks.iter_mut().zip(&base) {
+                for i in 0..b.len() {
+                    let z = (0..channels).map(|c| r[row + c].abs()).fold(0.0, f64::max) / sigma;
+                    row += channels;
+                    let w = match config.loss {
+                        RobustLoss::Huber(c) => {
+                            if z <= c {
+                                1.0
+                            } else {
+                                c / z
+                            }
+                        }
+                        RobustLoss::Cauchy(c) => 1.0 / (1.0 + (z / c) * (z / c)),
+                        RobustLoss::None => 1.0,
+                    };
+                    b.sqrt_weights[i] = orig.sqrt_weights[i] * w.sqrt();
+                }
+                b.set_factors(config.residual, floor);
+            }
+            let previous = u.clone();
+            (u, cost, termination) = solve(&blocks, u, 200);
+            if (&u - &previous).amax() < 1e-8 {
+                break;
+            }
+        }
+    }
+
+    let problem = Problem {
+        map: &map,
+        options: config.options,
+        orientation,
+        blocks: &blocks,
+        channels,
+        kind: config.residual,
+        floor,
+        u: u.clone(),
+        evaluations: Cell::new(0),
+    };
+    let (p, dp, material, scale) = problem.physical(&u).ok_or_else(|| FitError::Failed {
+        origin: label.into(),
+        reason: "the solution is not a valid material".into(),
+    })?;
+    let m_res = problem.n_residuals();
+    let stderr_u = problem
+        .jacobian_matrix(&u)
+        .and_then(|j| {
+            let dof = m_res.saturating_sub(map.len()).max(1) as f64;
+            let s2 = 2.0 * cost / dof;
+            (j.transpose() * &j).try_inverse().map(|inv| {
+                (0..map.len())
+                    .map(|i| (s2 * inv[(i, i)]).max(0.0).sqrt())
+                    .collect::<Vec<f64>>()
+            })
+        })
+        .unwrap_or_else(|| vec![f64::NAN; map.len()]);
+
+    // Report every material argument by name.
+    let args = material.args().to_vec();
+    let mut params = Vec::new();
+    let mut warnings = Vec::new();
+    for (a, name) in config.kind.param_names().iter().enumerate() {
+        let slot = map.slot_of_arg(a);
+        let (stderr, at_bound, fixed) = match slot {
+            Some(i) => (stderr_u[i] * dp[i].abs(), map.at_bound(i, p[i]), false),
+            None => (0.0, false, true),
+        };
+        if at_bound {
+            warnings.push(format!("{name} = {:.6} ended at a bound", args[a]));
+        }
+        params.push(ParamEstimate {
+            name: (*name).into(),
+            value: args[a],
+            stderr,
+            at_bound,
+            fixed,
+        });
+    }
+    if let Some(i) = map.slots.iter().position(|s| s.target == Target::Scale) {
+        params.push(ParamEstimate {
+            name: "scale".into(),
+            value: scale,
+            stderr: stderr_u[i] * dp[i].abs(),
+            at_bound: map.at_bound(i, p[i]),
+            fixed: false,
+        });
+        warnings.push(
+            "free scale: the colour is fixed at 1, so `scale` is scale × colour; give the beam integral or a known reflectance for absolute colour".into(),
+        );
+    }
+    if args[3] < 1e-4 {
+        warnings
+            .push("specularity ≈ 0: the lobe is degenerate and its roughness meaningless".into());
+    }
+    if !termination.was_successful() {
+        warnings.push(format!(
+            "optimiser stopped without converging: {termination:?}"
+        ));
+    }
+
+    // Unweighted relative RMS, independent of the residual kind.
+    let mut sum = 0.0;
+    let bsdf = brtf_model::Bsdf::new(&material, &config.options);
+    for b in &blocks {
+        for (v, y) in b.views.iter().zip(&b.values) {
+            let f = bsdf.eval(b.light, *v);
+            for ch in 0..channels {
+                let e = (scale * f[ch] - y[ch]) / (y[ch] * y[ch] + floor * floor).sqrt();
+                sum += e * e;
+            }
+        }
+    }
+    let rms_rel = (sum / (n_points * channels).max(1) as f64).sqrt();
+    let single = data.len() == 1;
+    Ok(FitReport {
+        source: label.into(),
+        theta_in: if single { data[0].theta_in } else { 0.0 },
+        phi_in: if single { data[0].phi_in } else { 0.0 },
+        params,
+        material_args: args,
+        scale,
+        n_points,
+        gates: if single {
+            data[0].gates.clone()
+        } else {
+            Vec::new()
+        },
+        weighting: data[0].weighting.clone(),
+        rms_rel,
+        cost,
+        floor,
+        termination: Termination::from_lm(&termination),
+        evaluations: evaluations.get(),
+        elapsed_ms: started.elapsed().as_secs_f64() * 1e3,
+        starts: records,
+        warnings,
+    })
+}
+
+/// 1.4826 × the median absolute residual, a robust standard deviation.
+fn robust_sigma(r: &DVector<f64>) -> f64 {
+    let mut a: Vec<f64> = r.iter().map(|x| x.abs()).collect();
+    let mid = a.len() / 2;
+    a.select_nth_unstable_by(mid, f64::total_cmp);
+    (1.4826 * a[mid]).max(1e-300)
+}
+
+/// Normalised weights: each block's weights average 1, so the cost reads
+/// like an unweighted sum and (for the global fit) every incidence counts
+/// the same.
+fn make_block(d: &IncidenceData, _global: bool) -> Block {
+    let total: f64 = d.samples.iter().map(|s| s.weight.max(0.0)).sum();
+    let mean = if total > 0.0 {
+        total / d.samples.len() as f64
+    } else {
+        1.0
+    };
+    Block {
+        light: d.light(),
+        views: d.samples.iter().map(|s| s.view).collect(),
+        values: d.samples.iter().map(|s| s.value).collect(),
+        sqrt_weights: d
+            .samples
+            .iter()
+            .map(|s| {
+                if total > 0.0 {
+                    (s.weight.max(0.0) / mean).sqrt()
+                } else {
+                    1.0
+                }
+            })
+            .collect(),
+        factors: Vec::new(),
+    }
+}
+
+/// Every k-th sample, keeping the block's weight total.
+fn subsample(b: &Block, target: usize) -> Block {
+    let step = (b.len() / target.max(1)).max(1);
+    let pick = |i: &usize| i % step == 0;
+    let idx: Vec<usize> = (0..b.len()).filter(pick).collect();
+    let w = (step as f64).sqrt();
+    Block {
+        light: b.light,
+        views: idx.iter().map(|&i| b.views[i]).collect(),
+        values: idx.iter().map(|&i| b.values[i]).collect(),
+        sqrt_weights: idx.iter().map(|&i| b.sqrt_weights[i] * w).collect(),
+        factors: idx.iter().map(|&i| b.factors[i].map(|k| k * w)).collect(),
+    }
+}
+
+/// 10% of the 10th percentile of the positive values: below this, values
+/// count as noise for relative and log residuals.
+fn auto_floor(data: &[IncidenceData], channels: usize) -> f64 {
+    let mut values: Vec<f64> = data
+        .iter()
+        .flat_map(|d| {
+            d.samples
+                .iter()
+                .flat_map(move |s| s.value[..channels].to_vec())
+        })
+        .filter(|v| *v > 0.0)
+        .collect();
+    if values.is_empty() {
+        return 1e-6;
+    }
+    let k = values.len() / 10;
+    values.select_nth_unstable_by(k, f64::total_cmp);
+    (0.1 * values[k]).max(1e-12)
+}
+
+/// Lobe features read off the data of one incidence.
+struct DataFeatures {
+    /// Diffuse reflectance estimate (π × a low percentile).
+    diffuse: f64,
+    /// Peak height above the floor, in the data's unit.
+    peak: f64,
+    /// Angle (rad) from the mirror direction where the lobe falls to 1/e.
+    width: f64,
+    /// cos θ_in.
+    cos_in: f64,
+    /// Transmission estimate (back hemisphere).
+    transmission: f64,
+}
+
+fn features(d: &IncidenceData, channels: usize) -> DataFeatures {
+    let l = d.light();
+    let mirror = DVec3::new(-l.x, -l.y, l.z);
+    let mean =
+        |s: &crate::data::FitSample| s.value[..channels].iter().sum::<f64>() / channels as f64;
+    let mut front: Vec<f64> = d
+        .samples
+        .iter()
+        .filter(|s| s.view.z > 0.0)
+        .map(mean)
+        .collect();
+    let mut back: Vec<f64> = d
+        .samples
+        .iter()
+        .filter(|s| s.view.z < 0.0)
+        .map(mean)
+        .collect();
+    let percentile = |v: &mut Vec<f64>, q: f64| -> f64 {
+        if v.is_empty() {
+            return 0.0;
+        }
+        let k = ((v.len() - 1) as f64 * q) as usize;
+        *v.select_nth_unstable_by(k, f64::total_cmp).1
+    };
+    let floor = percentile(&mut front, 0.2).max(0.0);
+    // The peak: the largest value within 30° of the mirror direction.
+    let near: Vec<(f64, f64)> = d
+        .samples
+        .iter()
+        .filter(|s| s.view.z > 0.0)
+        .map(|s| (s.view.angle_between(mirror), mean(s)))
+        .filter(|(delta, _)| *delta < 0.5)
+        .collect();
+    let peak = near.iter().map(|(_, y)| *y).fold(0.0, f64::max) - floor;
+    let threshold = floor + peak / std::f64::consts::E;
+    let width = near
+        .iter()
+        .filter(|(_, y)| *y >= threshold)
+        .map(|(delta, _)| *delta)
+        .fold(0.0, f64::max)
+        .max(0.005);
+    let back_median = percentile(&mut back, 0.5).max(0.0);
+    DataFeatures {
+        diffuse: (PI * floor).min(1.0),
+        peak: peak.max(0.0),
+        width,
+        cos_in: l.z.abs().max(0.05),
+        transmission: (PI * back_median).min(1.0),
+    }
+}
+
+/// Starting points: the data-driven roughness first, then a roughness
+/// grid. Each start derives the amplitudes from the data for its roughness.
+fn starting_points(
+    data: &[IncidenceData],
+    map: &ParamMap,
+    config: &FitConfig,
+    channels: usize,
+) -> Vec<([f64; 2], DVector<f64>)> {
+    // Features of the incidence closest to 30° stand for all of them.
+    let reference = data
+        .iter()
+        .min_by(|a, b| {
+            (a.theta_in - 30.0)
+                .abs()
+                .total_cmp(&(b.theta_in - 30.0).abs())
+        })
+        .expect("at least one incidence");
+    let f = features(reference, channels);
+    let alpha0 = (0.5 * f.width).clamp(MIN_ROUGHNESS * 2.0, 0.5);
+    let mut roughs: Vec<[f64; 2]> = vec![[alpha0, alpha0]];
+    if config.multistart {
+        let grid = [0.01, 0.03, 0.08, 0.2, 0.4];
+        if config.kind.is_anisotropic() {
+            for &a in &[0.02, 0.08, 0.25] {
+                for &b in &[0.02, 0.08, 0.25] {
+                    roughs.push([a, b]);
+                }
+            }
+        } else {
+            for &a in &grid {
+                if (a / alpha0).ln().abs() > 0.3 {
+                    roughs.push([a, a]);
+                }
+            }
+        }
+    }
+    let means: [f64; 3] = {
+        let mut m = [0.0; 3];
+        let front: Vec<_> = reference
+            .samples
+            .iter()
+            .filter(|s| s.view.z > 0.0)
+            .collect();
+        for s in &front {
+            for c in 0..channels {
+                m[c] += s.value[c];
+            }
+        }
+        let total: f64 = m[..channels].iter().sum::<f64>().max(1e-300);
+        let mut ratio = [1.0; 3];
+        if channels == 3 {
+            for c in 0..3 {
+                ratio[c] = 3.0 * m[c] / total;
+            }
+        }
+        ratio
+    };
+    roughs
+        .into_iter()
+        .map(|rough| {
+            let alpha2 = rough[0] * rough[1];
+            // W-G-M-D peak height at the mirror direction: S/(4π α² cos²θ_in).
+            let spec_amp = (f.peak * 4.0 * PI * alpha2 * f.cos_in * f.cos_in).max(1e-4);
+            let total = (f.diffuse + spec_amp).max(1e-6);
+            let mut phys = Vec::new();
+            for slot in &map.slots {
+                let value = match slot.target {
+                    Target::Scale => total,
+                    Target::Gray => total.min(0.95),
+                    Target::Arg(a) if a < 3 => (total * means[a]).min(0.95),
+                    Target::Arg(3) => {
+                        let spec = if config.free_scale || config.kind.is_metal() {
+                            spec_amp / total
+                        } else {
+                            spec_amp
+                        };
+                        spec.clamp(0.01, 0.95)
+                    }
+                    Target::Arg(_) if slot.name == "rough" || slot.name == "rough_u" => rough[0],
+                    Target::Arg(_) if slot.name == "rough_v" => rough[1],
+                    Target::Arg(_) if slot.name == "trans" => f.transmission.clamp(0.05, 0.9),
+                    Target::Arg(_) => 0.5,
+                };
+                phys.push(value);
+            }
+            let u = DVector::from_iterator(
+                phys.len(),
+                phys.iter()
+                    .enumerate()
+                    .map(|(i, &p)| map.to_unconstrained(i, p)),
+            );
+            (rough, u)
+        })
+        .collect()
+}

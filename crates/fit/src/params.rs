@@ -1,0 +1,172 @@
+//! The map between the optimiser's unconstrained vector `u` and the
+//! physical parameters: a logistic for box bounds, `exp` for the positive
+//! scale. All of the fit's bound handling lives here.
+
+use brtf_model::MaterialKind;
+use serde::{Deserialize, Serialize};
+
+/// What one free parameter drives.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Target {
+    /// All three colour arguments at once (grey fit).
+    Gray,
+    /// One real argument of the material (index into its argument list).
+    Arg(usize),
+    /// The free overall scale factor for raw-signal data.
+    Scale,
+}
+
+/// One free parameter with its physical range.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Slot {
+    /// Name as in the fit tables (`red`, `spec`, `rough`, `scale`, ...).
+    pub name: String,
+    /// What it drives.
+    pub target: Target,
+    /// Lower physical bound.
+    pub lo: f64,
+    /// Upper physical bound (infinite for the scale).
+    pub hi: f64,
+}
+
+/// Lowest roughness the fit may reach: just above rtrace's roughness-0
+/// switch (α ≤ 0.001), below which the lobe vanishes from the direct term.
+pub const MIN_ROUGHNESS: f64 = 0.002;
+/// Highest roughness: beyond this the Gaussian-slope model is meaningless.
+pub const MAX_ROUGHNESS: f64 = 1.0;
+
+/// The free parameters of one fit.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ParamMap {
+    /// The material type being fitted.
+    #[serde(with = "crate::serde_kind")]
+    pub kind: MaterialKind,
+    /// The free parameters, in optimiser order.
+    pub slots: Vec<Slot>,
+    /// Material arguments not fitted (colour fixed to 1 under a free scale).
+    pub fixed: Vec<f64>,
+}
+
+impl ParamMap {
+    /// The free parameters for `kind`: a grey colour (`gray`) or RGB, the
+    /// other real arguments, and optionally a free scale (which fixes the
+    /// colour to 1, since only scale × colour is identified).
+    pub fn new(kind: MaterialKind, gray: bool, free_scale: bool) -> ParamMap {
+        let names = kind.param_names();
+        let mut slots = Vec::new();
+        let mut fixed = vec![0.0; kind.n_args()];
+        if free_scale {
+            fixed[..3].copy_from_slice(&[1.0; 3]);
+            slots.push(Slot {
+                name: "scale".into(),
+                target: Target::Scale,
+                lo: 0.0,
+                hi: f64::INFINITY,
+            });
+        } else if gray {
+            slots.push(Slot {
+                name: "gray".into(),
+                target: Target::Gray,
+                lo: 0.0,
+                hi: 1.0,
+            });
+        } else {
+            for (i, name) in names.iter().enumerate().take(3) {
+                slots.push(Slot {
+                    name: (*name).into(),
+                    target: Target::Arg(i),
+                    lo: 0.0,
+                    hi: 1.0,
+                });
+            }
+        }
+        for (i, name) in names.iter().enumerate().skip(3) {
+            let (lo, hi) = if name.starts_with("rough") {
+                (MIN_ROUGHNESS, MAX_ROUGHNESS)
+            } else {
+                (0.0, 1.0)
+            };
+            slots.push(Slot {
+                name: (*name).into(),
+                target: Target::Arg(i),
+                lo,
+                hi,
+            });
+        }
+        ParamMap { kind, slots, fixed }
+    }
+
+    /// Number of free parameters.
+    pub fn len(&self) -> usize {
+        self.slots.len()
+    }
+
+    /// True when nothing is free.
+    pub fn is_empty(&self) -> bool {
+        self.slots.is_empty()
+    }
+
+    /// Index of the slot driving material argument `arg`, if free.
+    pub fn slot_of_arg(&self, arg: usize) -> Option<usize> {
+        self.slots.iter().position(|s| match s.target {
+            Target::Arg(a) => a == arg,
+            Target::Gray => arg < 3,
+            Target::Scale => false,
+        })
+    }
+
+    /// Physical value of slot `i` for unconstrained `u`, and dp/du.
+    pub fn to_physical(&self, i: usize, u: f64) -> (f64, f64) {
+        let s = &self.slots[i];
+        if s.hi.is_infinite() {
+            let p = s.lo + u.exp();
+            return (p, u.exp());
+        }
+        let sig = logistic(u);
+        let p = s.lo + (s.hi - s.lo) * sig;
+        (p, (s.hi - s.lo) * sig * (1.0 - sig))
+    }
+
+    /// Unconstrained value for physical `p` (clamped just inside the bounds).
+    pub fn to_unconstrained(&self, i: usize, p: f64) -> f64 {
+        let s = &self.slots[i];
+        if s.hi.is_infinite() {
+            return (p - s.lo).max(1e-300).ln();
+        }
+        let t = ((p - s.lo) / (s.hi - s.lo)).clamp(1e-6, 1.0 - 1e-6);
+        (t / (1.0 - t)).ln()
+    }
+
+    /// Material arguments and scale for physical parameters `p`.
+    pub fn material_args(&self, p: &[f64]) -> (Vec<f64>, f64) {
+        let mut args = self.fixed.clone();
+        let mut scale = 1.0;
+        for (slot, &value) in self.slots.iter().zip(p) {
+            match slot.target {
+                Target::Gray => args[..3].copy_from_slice(&[value; 3]),
+                Target::Arg(a) => args[a] = value,
+                Target::Scale => scale = value,
+            }
+        }
+        (args, scale)
+    }
+
+    /// True when physical value `p` of slot `i` sits at a bound.
+    pub fn at_bound(&self, i: usize, p: f64) -> bool {
+        let s = &self.slots[i];
+        if s.hi.is_infinite() {
+            return p <= s.lo + 1e-12;
+        }
+        let t = (p - s.lo) / (s.hi - s.lo);
+        !(1e-4..=1.0 - 1e-4).contains(&t)
+    }
+}
+
+fn logistic(u: f64) -> f64 {
+    if u >= 0.0 {
+        1.0 / (1.0 + (-u).exp())
+    } else {
+        let e = u.exp();
+        e / (1.0 + e)
+    }
+}

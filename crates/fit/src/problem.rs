@@ -1,0 +1,166 @@
+//! The least-squares problem handed to the levenberg-marquardt crate:
+//! residuals and the exact Jacobian from brtf-model's analytic gradients,
+//! in the unconstrained coordinates of [`ParamMap`].
+
+use crate::params::{ParamMap, Target};
+use brtf_model::{Bsdf, EvalOptions, Gradient, Material};
+use glam::DVec3;
+use levenberg_marquardt::LeastSquaresProblem;
+use nalgebra::{DMatrix, DVector, Dyn, Owned};
+use serde::{Deserialize, Serialize};
+use std::cell::Cell;
+
+/// How a model value m is compared with a measured value y.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum ResidualKind {
+    /// `m − y`: dominated by the specular peak.
+    Absolute,
+    /// `(m − y) / sqrt(y² + floor²)`: every direction counts alike; right
+    /// for multiplicative noise on top of a noise floor. The default.
+    #[default]
+    Relative,
+    /// `ln(m + floor) − ln(max(y, 0) + floor)`.
+    Log,
+}
+
+/// The samples of one incidence, ready for the inner loop.
+#[derive(Debug, Clone)]
+pub(crate) struct Block {
+    pub light: DVec3,
+    pub views: Vec<DVec3>,
+    pub values: Vec<[f64; 3]>,
+    /// √(weight) per sample, including any robust-loss reweighting.
+    pub sqrt_weights: Vec<f64>,
+    /// Per sample and channel, the factor turning `m − y` into a residual
+    /// (relative and absolute kinds).
+    pub factors: Vec<[f64; 3]>,
+}
+
+impl Block {
+    pub(crate) fn len(&self) -> usize {
+        self.views.len()
+    }
+
+    /// Recomputes the residual factors for `kind` and `floor`.
+    pub(crate) fn set_factors(&mut self, kind: ResidualKind, floor: f64) {
+        self.factors = self
+            .values
+            .iter()
+            .zip(&self.sqrt_weights)
+            .map(|(y, &sw)| {
+                y.map(|yc| match kind {
+                    ResidualKind::Relative => sw / (yc * yc + floor * floor).sqrt(),
+                    ResidualKind::Absolute | ResidualKind::Log => sw,
+                })
+            })
+            .collect();
+    }
+}
+
+pub(crate) struct Problem<'a> {
+    pub map: &'a ParamMap,
+    pub options: EvalOptions,
+    pub orientation: DVec3,
+    pub blocks: &'a [Block],
+    pub channels: usize,
+    pub kind: ResidualKind,
+    pub floor: f64,
+    pub u: DVector<f64>,
+    pub evaluations: Cell<usize>,
+}
+
+impl Problem<'_> {
+    pub(crate) fn n_residuals(&self) -> usize {
+        self.blocks.iter().map(Block::len).sum::<usize>() * self.channels
+    }
+
+    /// Physical parameters, their derivatives dp/du, the material and scale.
+    pub(crate) fn physical(&self, u: &DVector<f64>) -> Option<(Vec<f64>, Vec<f64>, Material, f64)> {
+        let (p, dp): (Vec<f64>, Vec<f64>) = (0..self.map.len())
+            .map(|i| self.map.to_physical(i, u[i]))
+            .unzip();
+        let (args, scale) = self.map.material_args(&p);
+        let material = Material::new(self.map.kind, &args, Some(self.orientation)).ok()?;
+        Some((p, dp, material, scale))
+    }
+
+    /// Residual for model `m` and measured `y` with factor `k`, and dr/dm.
+    #[inline(always)]
+    fn residual(&self, m: f64, y: f64, k: f64) -> (f64, f64) {
+        match self.kind {
+            ResidualKind::Absolute | ResidualKind::Relative => (k * (m - y), k),
+            ResidualKind::Log => {
+                let a = m.max(0.0) + self.floor;
+                (k * (a.ln() - (y.max(0.0) + self.floor).ln()), k / a)
+            }
+        }
+    }
+
+    pub(crate) fn residual_vector(&self, u: &DVector<f64>) -> Option<DVector<f64>> {
+        let (_, _, material, scale) = self.physical(u)?;
+        let bsdf = Bsdf::new(&material, &self.options);
+        let mut r = DVector::zeros(self.n_residuals());
+        let mut row = 0;
+        for block in self.blocks {
+            for ((v, y), k) in block.views.iter().zip(&block.values).zip(&block.factors) {
+                let f = bsdf.eval(block.light, *v);
+                for ch in 0..self.channels {
+                    r[row] = self.residual(scale * f[ch], y[ch], k[ch]).0;
+                    row += 1;
+                }
+            }
+        }
+        self.evaluations.set(self.evaluations.get() + 1);
+        r.iter().all(|x| x.is_finite()).then_some(r)
+    }
+
+    pub(crate) fn jacobian_matrix(&self, u: &DVector<f64>) -> Option<DMatrix<f64>> {
+        let (_, dp, material, scale) = self.physical(u)?;
+        let bsdf = Bsdf::new(&material, &self.options);
+        let n = self.map.len();
+        let m = self.n_residuals();
+        let mut jac = DMatrix::zeros(m, n);
+        let mut grad = Gradient::default();
+        let mut row = 0;
+        for block in self.blocks {
+            for ((v, y), k) in block.views.iter().zip(&block.values).zip(&block.factors) {
+                let f = bsdf.eval_with_gradient(block.light, *v, &mut grad);
+                for ch in 0..self.channels {
+                    let (_, dr_dm) = self.residual(scale * f[ch], y[ch], k[ch]);
+                    for (j, slot) in self.map.slots.iter().enumerate() {
+                        let dm_dp = match slot.target {
+                            Target::Arg(a) => scale * grad.d[a][ch],
+                            Target::Gray => scale * (grad.d[0][ch] + grad.d[1][ch] + grad.d[2][ch]),
+                            Target::Scale => f[ch],
+                        };
+                        jac[(row, j)] = dr_dm * dm_dp * dp[j];
+                    }
+                    row += 1;
+                }
+            }
+        }
+        jac.iter().all(|x| x.is_finite()).then_some(jac)
+    }
+}
+
+impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
+    type ResidualStorage = Owned<f64, Dyn>;
+    type JacobianStorage = Owned<f64, Dyn, Dyn>;
+    type ParameterStorage = Owned<f64, Dyn>;
+
+    fn set_params(&mut self, u: &DVector<f64>) {
+        self.u.copy_from(u);
+    }
+
+    fn params(&self) -> DVector<f64> {
+        self.u.clone()
+    }
+
+    fn residuals(&self) -> Option<DVector<f64>> {
+        self.residual_vector(&self.u)
+    }
+
+    fn jacobian(&self) -> Option<DMatrix<f64>> {
+        self.jacobian_matrix(&self.u)
+    }
+}

@@ -1,0 +1,208 @@
+//! Per-incidence parameters as a function of θ_in: a monotone cubic
+//! (PCHIP, Fritsch–Carlson) or linear interpolation, clamped outside the
+//! measured range.
+
+use crate::fitter::FitReport;
+use brtf_model::{Material, MaterialKind, ModelError};
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+
+/// How parameters are interpolated between measured incidences.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum Interpolation {
+    /// Piecewise cubic Hermite with Fritsch–Carlson slopes: no overshoot,
+    /// monotone where the data are.
+    #[default]
+    Pchip,
+    /// Piecewise linear.
+    Linear,
+}
+
+/// Why a table could not be built.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum TableError {
+    /// Interpolation needs two incidences or more.
+    #[error("θ_in interpolation needs at least two incidences, found {0}")]
+    NeedTwoIncidences(usize),
+    /// Two rows share a θ_in.
+    #[error("two incidences share θ_in = {0}°; give one file per incidence")]
+    DuplicateTheta(f64),
+    /// The interpolated parameters are not a valid material.
+    #[error("interpolated parameters are not a valid material: {0}")]
+    Material(#[from] ModelError),
+}
+
+/// Material parameters tabulated over θ_in.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ParamTable {
+    /// The material type.
+    #[serde(with = "crate::serde_kind")]
+    pub kind: MaterialKind,
+    /// Orientation of the `*2` types.
+    pub orientation: [f64; 3],
+    /// Interpolation method.
+    pub method: Interpolation,
+    /// θ_in of each row, ascending, in degrees.
+    pub theta_in: Vec<f64>,
+    /// `args[row]`: the material's real arguments at that θ_in.
+    pub args: Vec<Vec<f64>>,
+}
+
+/// A material at some θ_in, and whether θ_in was outside the table.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TableLookup {
+    /// The interpolated material.
+    pub material: Material,
+    /// θ_in was outside the measured range, so the end row was used.
+    pub clamped: bool,
+}
+
+impl ParamTable {
+    /// Builds the table from per-incidence reports (sorted by θ_in here).
+    pub fn from_reports(
+        kind: MaterialKind,
+        orientation: [f64; 3],
+        reports: &[FitReport],
+        method: Interpolation,
+    ) -> Result<ParamTable, TableError> {
+        if reports.len() < 2 {
+            return Err(TableError::NeedTwoIncidences(reports.len()));
+        }
+        let mut rows: Vec<(f64, Vec<f64>)> = reports
+            .iter()
+            .map(|r| (r.theta_in, r.material_args.clone()))
+            .collect();
+        rows.sort_by(|a, b| a.0.total_cmp(&b.0));
+        if let Some(w) = rows.windows(2).find(|w| (w[1].0 - w[0].0).abs() < 1e-9) {
+            return Err(TableError::DuplicateTheta(w[0].0));
+        }
+        Ok(ParamTable {
+            kind,
+            orientation,
+            method,
+            theta_in: rows.iter().map(|r| r.0).collect(),
+            args: rows.into_iter().map(|r| r.1).collect(),
+        })
+    }
+
+    /// Measured θ_in range.
+    pub fn range(&self) -> (f64, f64) {
+        (
+            self.theta_in[0],
+            *self.theta_in.last().expect("two rows or more"),
+        )
+    }
+
+    /// Interpolated real arguments at `theta_in` (clamped to the range).
+    pub fn args_at(&self, theta_in: f64) -> (Vec<f64>, bool) {
+        let (lo, hi) = self.range();
+        let clamped = theta_in < lo || theta_in > hi;
+        let t = theta_in.clamp(lo, hi);
+        let n_args = self.args[0].len();
+        let args = (0..n_args)
+            .map(|j| {
+                let ys: Vec<f64> = self.args.iter().map(|row| row[j]).collect();
+                match self.method {
+                    Interpolation::Linear => linear(&self.theta_in, &ys, t),
+                    Interpolation::Pchip => pchip(&self.theta_in, &ys, t),
+                }
+            })
+            .collect();
+        (args, clamped)
+    }
+
+    /// The material at `theta_in`.
+    pub fn at(&self, theta_in: f64) -> Result<TableLookup, TableError> {
+        let (args, clamped) = self.args_at(theta_in);
+        let material = Material::new(self.kind, &args, Some(DVec3::from_array(self.orientation)))?;
+        Ok(TableLookup { material, clamped })
+    }
+}
+
+fn segment(xs: &[f64], x: f64) -> usize {
+    xs.windows(2)
+        .position(|w| x <= w[1])
+        .unwrap_or(xs.len() - 2)
+}
+
+fn linear(xs: &[f64], ys: &[f64], x: f64) -> f64 {
+    let i = segment(xs, x);
+    let t = (x - xs[i]) / (xs[i + 1] - xs[i]);
+    ys[i] + t * (ys[i + 1] - ys[i])
+}
+
+/// Fritsch–Carlson slopes: harmonic mean of neighbouring secants where they
+/// share a sign, zero at local extrema; one-sided three-point ends.
+fn pchip_slopes(xs: &[f64], ys: &[f64]) -> Vec<f64> {
+    let n = xs.len();
+    let h: Vec<f64> = xs.windows(2).map(|w| w[1] - w[0]).collect();
+    let delta: Vec<f64> = (0..n - 1).map(|i| (ys[i + 1] - ys[i]) / h[i]).collect();
+    if n == 2 {
+        return vec![delta[0]; 2];
+    }
+    let mut d = vec![0.0; n];
+    for i in 1..n - 1 {
+        if delta[i - 1] * delta[i] > 0.0 {
+            let w1 = 2.0 * h[i] + h[i - 1];
+            let w2 = h[i] + 2.0 * h[i - 1];
+            d[i] = (w1 + w2) / (w1 / delta[i - 1] + w2 / delta[i]);
+        }
+    }
+    let end = |h0: f64, h1: f64, d0: f64, d1: f64| {
+        let s = ((2.0 * h0 + h1) * d0 - h0 * d1) / (h0 + h1);
+        if s * d0 <= 0.0 {
+            0.0
+        } else if d0 * d1 <= 0.0 && s.abs() > 3.0 * d0.abs() {
+            3.0 * d0
+        } else {
+            s
+        }
+    };
+    d[0] = end(h[0], h[1], delta[0], delta[1]);
+    d[n - 1] = end(h[n - 2], h[n - 3], delta[n - 2], delta[n - 3]);
+    d
+}
+
+fn pchip(xs: &[f64], ys: &[f64], x: f64) -> f64 {
+    let d = pchip_slopes(xs, ys);
+    let i = segment(xs, x);
+    let h = xs[i + 1] - xs[i];
+    let t = (x - xs[i]) / h;
+    let (t2, t3) = (t * t, t * t * t);
+    let h00 = 2.0 * t3 - 3.0 * t2 + 1.0;
+    let h10 = t3 - 2.0 * t2 + t;
+    let h01 = -2.0 * t3 + 3.0 * t2;
+    let h11 = t3 - t2;
+    h00 * ys[i] + h10 * h * d[i] + h01 * ys[i + 1] + h11 * h * d[i + 1]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pchip_interpolates_nodes_and_keeps_monotone_data_monotone() {
+        let xs = [0.0, 15.0, 30.0, 45.0, 60.0];
+        let ys = [0.1, 0.1, 0.12, 0.3, 0.31];
+        for (x, y) in xs.iter().zip(ys) {
+            assert!((pchip(&xs, &ys, *x) - y).abs() < 1e-12);
+        }
+        let mut last = f64::NEG_INFINITY;
+        for k in 0..=600 {
+            let v = pchip(&xs, &ys, k as f64 * 0.1);
+            assert!(
+                v >= last - 1e-12 && (0.1 - 1e-12..=0.31 + 1e-12).contains(&v),
+                "overshoot at {k}: {v}"
+            );
+            last = v;
+        }
+    }
+
+    #[test]
+    fn linear_is_exact_on_lines() {
+        let xs = [0.0, 10.0, 40.0];
+        let ys = [1.0, 2.0, 5.0];
+        assert!((linear(&xs, &ys, 25.0) - 3.5).abs() < 1e-12);
+    }
+}
