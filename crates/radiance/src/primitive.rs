@@ -7,14 +7,65 @@ use std::fmt;
 
 /// Every primitive type Radiance 6 knows, so misspellings are caught.
 const RADIANCE_TYPES: &[&str] = &[
-    "source", "sphere", "bubble", "polygon", "cone", "cup", "cylinder", "tube", "ring",
-    "instance", "mesh", "light", "illum", "glow", "spotlight", "mirror", "mist", "prism1",
-    "prism2", "metal", "metal2", "plastic", "plastic2", "trans", "trans2", "dielectric",
-    "interface", "glass", "plasfunc", "metfunc", "transfunc", "BRTDfunc", "plasdata",
-    "metdata", "transdata", "BSDF", "aBSDF", "ashik2", "WGMDfunc", "antimatter", "texfunc",
-    "texdata", "colorfunc", "brightfunc", "colordata", "brightdata", "colorpict",
-    "colortext", "brighttext", "mixfunc", "mixdata", "mixpict", "mixtext", "alias",
-    "spectrum", "specfile", "specfunc", "specdata", "specpict",
+    "source",
+    "sphere",
+    "bubble",
+    "polygon",
+    "cone",
+    "cup",
+    "cylinder",
+    "tube",
+    "ring",
+    "instance",
+    "mesh",
+    "light",
+    "illum",
+    "glow",
+    "spotlight",
+    "mirror",
+    "mist",
+    "prism1",
+    "prism2",
+    "metal",
+    "metal2",
+    "plastic",
+    "plastic2",
+    "trans",
+    "trans2",
+    "dielectric",
+    "interface",
+    "glass",
+    "plasfunc",
+    "metfunc",
+    "transfunc",
+    "BRTDfunc",
+    "plasdata",
+    "metdata",
+    "transdata",
+    "BSDF",
+    "aBSDF",
+    "ashik2",
+    "WGMDfunc",
+    "antimatter",
+    "texfunc",
+    "texdata",
+    "colorfunc",
+    "brightfunc",
+    "colordata",
+    "brightdata",
+    "colorpict",
+    "colortext",
+    "brighttext",
+    "mixfunc",
+    "mixdata",
+    "mixpict",
+    "mixtext",
+    "alias",
+    "spectrum",
+    "specfile",
+    "specfunc",
+    "specdata",
+    "specpict",
 ];
 
 /// A parse or conversion error, located in a file.
@@ -69,7 +120,9 @@ fn tokenize<'a>(text: &'a str, path: &str) -> Result<Vec<Token<'a>>, RadError> {
             return Err(RadError {
                 path: path.to_string(),
                 line,
-                message: "inline commands (`!...`) are not supported; run them first and save the output".into(),
+                message:
+                    "inline commands (`!...`) are not supported; run them first and save the output"
+                        .into(),
             });
         }
         tokens.extend(content.split_whitespace().map(|t| Token { text: t, line }));
@@ -99,7 +152,10 @@ impl<'t, 'a> Cursor<'t, 'a> {
 
     fn next(&mut self, what: &str, context: &str) -> Result<&'t Token<'a>, RadError> {
         let token = self.tokens.get(self.pos).ok_or_else(|| {
-            self.error(self.last_line(), format!("file ends {context}: expected {what}"))
+            self.error(
+                self.last_line(),
+                format!("file ends {context}: expected {what}"),
+            )
         })?;
         self.pos += 1;
         Ok(token)
@@ -112,14 +168,19 @@ impl<'t, 'a> Cursor<'t, 'a> {
         let n = t.text.parse::<usize>().map_err(|_| {
             self.error(
                 t.line,
-                format!("`{name}`: expected the number of {what} arguments, found `{}`", t.text),
+                format!(
+                    "`{name}`: expected the number of {what} arguments, found `{}`",
+                    t.text
+                ),
             )
         })?;
         let available = self.tokens.len() - self.pos;
         if n > available {
             return Err(self.error(
                 self.last_line(),
-                format!("`{name}` declares {n} {what} arguments but the file ends after {available}"),
+                format!(
+                    "`{name}` declares {n} {what} arguments but the file ends after {available}"
+                ),
             ));
         }
         let slice = &self.tokens[self.pos..self.pos + n];
@@ -147,15 +208,30 @@ pub fn parse_primitives(text: &str, path: &str) -> Result<Vec<Primitive>, RadErr
             return Err(cursor.error(kind_token.line, format!("unknown primitive type `{kind}`")));
         }
         let name = cursor.next("an identifier", &context)?.text.to_string();
-        let strings = cursor.list(&name, "string")?.iter().map(|t| t.text.to_string()).collect();
-        let ints = cursor.list(&name, "integer")?.iter().map(|t| t.text.to_string()).collect();
+        let strings = cursor
+            .list(&name, "string")?
+            .iter()
+            .map(|t| t.text.to_string())
+            .collect();
+        let ints = cursor
+            .list(&name, "integer")?
+            .iter()
+            .map(|t| t.text.to_string())
+            .collect();
         let reals = cursor
             .list(&name, "real")?
             .iter()
             .map(|t| {
-                t.text.parse::<f64>().ok().filter(|x| x.is_finite()).ok_or_else(|| {
-                    cursor.error(t.line, format!("`{name}`: real argument `{}` is not a number", t.text))
-                })
+                t.text
+                    .parse::<f64>()
+                    .ok()
+                    .filter(|x| x.is_finite())
+                    .ok_or_else(|| {
+                        cursor.error(
+                            t.line,
+                            format!("`{name}`: real argument `{}` is not a number", t.text),
+                        )
+                    })
             })
             .collect::<Result<Vec<f64>, RadError>>()?;
         primitives.push(Primitive {
@@ -185,7 +261,12 @@ pub fn material_from_primitive(p: &Primitive, path: &str) -> Result<Material, Ra
         ))
     })?;
     if !p.ints.is_empty() {
-        return Err(err(format!("{} `{}` takes 0 integer arguments, found {}", kind, p.name, p.ints.len())));
+        return Err(err(format!(
+            "{} `{}` takes 0 integer arguments, found {}",
+            kind,
+            p.name,
+            p.ints.len()
+        )));
     }
     let orientation = if kind.is_anisotropic() {
         if p.strings.len() != 4 {
@@ -198,13 +279,20 @@ pub fn material_from_primitive(p: &Primitive, path: &str) -> Result<Material, Ra
         let mut xyz = [0.0; 3];
         for (i, s) in p.strings[..3].iter().enumerate() {
             xyz[i] = s.parse::<f64>().map_err(|_| {
-                err(format!("{kind} `{}`: orientation component `{s}` must be a numeric constant here", p.name))
+                err(format!(
+                    "{kind} `{}`: orientation component `{s}` must be a numeric constant here",
+                    p.name
+                ))
             })?;
         }
         Some(DVec3::from_array(xyz))
     } else {
         if !p.strings.is_empty() {
-            return Err(err(format!("{kind} `{}` takes 0 string arguments, found {}", p.name, p.strings.len())));
+            return Err(err(format!(
+                "{kind} `{}` takes 0 string arguments, found {}",
+                p.name,
+                p.strings.len()
+            )));
         }
         None
     };
@@ -227,11 +315,14 @@ pub fn select_material(
 ) -> Result<(String, Material), RadError> {
     let is_ward = |p: &&Primitive| p.kind.parse::<MaterialKind>().is_ok();
     let chosen = match name {
-        Some(name) => primitives.iter().find(|p| p.name == name).ok_or_else(|| RadError {
-            path: path.to_string(),
-            line: 1,
-            message: format!("no primitive named `{name}` in the file"),
-        })?,
+        Some(name) => primitives
+            .iter()
+            .find(|p| p.name == name)
+            .ok_or_else(|| RadError {
+                path: path.to_string(),
+                line: 1,
+                message: format!("no primitive named `{name}` in the file"),
+            })?,
         None => {
             let candidates: Vec<&Primitive> = primitives.iter().filter(is_ward).collect();
             match candidates.as_slice() {
@@ -248,7 +339,10 @@ pub fn select_material(
                     return Err(RadError {
                         path: path.to_string(),
                         line: many[1].line,
-                        message: format!("several materials ({}); choose one with --name", names.join(", ")),
+                        message: format!(
+                            "several materials ({}); choose one with --name",
+                            names.join(", ")
+                        ),
                     });
                 }
             }

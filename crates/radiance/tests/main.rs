@@ -33,7 +33,10 @@ fn parses_materials_with_comments_and_several_primitives() {
 fn selects_by_name_or_refuses_ambiguity() {
     let prims = parse_primitives(SCENE, "scene.rad").unwrap();
     let (name, m) = select_material(&prims, Some("painted"), "scene.rad").unwrap();
-    assert_eq!((name.as_str(), m.kind()), ("painted", MaterialKind::Plastic2));
+    assert_eq!(
+        (name.as_str(), m.kind()),
+        ("painted", MaterialKind::Plastic2)
+    );
     let err = select_material(&prims, None, "scene.rad").unwrap_err();
     assert!(err.to_string().contains("alu, painted"), "{err}");
     let err = select_material(&prims, Some("lamp"), "scene.rad").unwrap_err();
@@ -60,13 +63,41 @@ fn round_trips_through_text() {
 #[test]
 fn errors_name_file_line_and_problem() {
     let cases = [
-        ("void metal a 0 0 4 .8 .8 .8 .7\n", "m.rad:1:", "takes 5 real arguments, found 4"),
-        ("\nvoid metal a 0 0 5 .8 .8 x .7 .1\n", "m.rad:2:", "real argument `x` is not a number"),
-        ("void metall a 0 0 5 .8 .8 .8 .7 .1\n", "m.rad:1:", "unknown primitive type `metall`"),
-        ("void metal a 0 0 5 .8 .8\n", "m.rad:1:", "declares 5 real arguments"),
-        ("void metal a\n0\n0\nfive\n", "m.rad:4:", "number of real arguments"),
-        ("void metal2 b 4 1 0 0 . 0 5 .8 .8 .8 .7 .1\n", "m.rad:1:", "takes 6 real arguments"),
-        ("void metal2 b 4 A B C . 0 6 .8 .8 .8 .7 .1 .1\n", "m.rad:1:", "numeric constant"),
+        (
+            "void metal a 0 0 4 .8 .8 .8 .7\n",
+            "m.rad:1:",
+            "takes 5 real arguments, found 4",
+        ),
+        (
+            "\nvoid metal a 0 0 5 .8 .8 x .7 .1\n",
+            "m.rad:2:",
+            "real argument `x` is not a number",
+        ),
+        (
+            "void metall a 0 0 5 .8 .8 .8 .7 .1\n",
+            "m.rad:1:",
+            "unknown primitive type `metall`",
+        ),
+        (
+            "void metal a 0 0 5 .8 .8\n",
+            "m.rad:1:",
+            "declares 5 real arguments",
+        ),
+        (
+            "void metal a\n0\n0\nfive\n",
+            "m.rad:4:",
+            "number of real arguments",
+        ),
+        (
+            "void metal2 b 4 1 0 0 . 0 5 .8 .8 .8 .7 .1\n",
+            "m.rad:1:",
+            "takes 6 real arguments",
+        ),
+        (
+            "void metal2 b 4 A B C . 0 6 .8 .8 .8 .7 .1 .1\n",
+            "m.rad:1:",
+            "numeric constant",
+        ),
         ("!gensurf a b\n", "m.rad:1:", "inline commands"),
     ];
     for (text, location, problem) in cases {
@@ -74,6 +105,9 @@ fn errors_name_file_line_and_problem() {
             .and_then(|p| material_from_primitive(&p[0], "m.rad").map(|_| ()))
             .unwrap_err()
             .to_string();
-        assert!(err.starts_with(location) && err.contains(problem), "{text:?}: got `{err}`");
+        assert!(
+            err.starts_with(location) && err.contains(problem),
+            "{text:?}: got `{err}`"
+        );
     }
 }
