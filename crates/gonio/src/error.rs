@@ -4,7 +4,9 @@
 //! file's display path and the 1-based line number and print as
 //! `file:line: message`, like a compiler. The message says what was
 //! expected and what was found. [`ParseErrorKind`] lets callers (and tests)
-//! match on the kind of problem without parsing text.
+//! match on the kind of problem without parsing text. I/O errors keep the
+//! operating-system error as their `source()` (print the chain, e.g. with
+//! anyhow's `{:#}`, to see it).
 
 use std::io;
 use std::path::{Path, PathBuf};
@@ -14,7 +16,7 @@ use std::path::{Path, PathBuf};
 #[non_exhaustive]
 pub enum ReadError {
     /// The file could not be opened or read.
-    #[error("{}: cannot read: {source}", .path.display())]
+    #[error("{}: cannot read", .path.display())]
     Io {
         /// The file.
         path: PathBuf,
@@ -200,7 +202,7 @@ pub enum ParseErrorKind {
 #[non_exhaustive]
 pub enum WriteError {
     /// Creating, writing or renaming the file failed.
-    #[error("{}: cannot write: {source}", .path.display())]
+    #[error("{}: cannot write", .path.display())]
     Io {
         /// The target file.
         path: PathBuf,

@@ -201,6 +201,15 @@ impl Measurement {
     }
 }
 
+/// Six significant digits, in plain or exponent notation.
+fn significant(v: f64) -> String {
+    if v == 0.0 || (1e-3..1e6).contains(&v.abs()) {
+        format!("{v:.6}")
+    } else {
+        format!("{v:.5e}")
+    }
+}
+
 impl fmt::Display for Summary {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let origin = match self.incidence_origin {
@@ -252,21 +261,25 @@ impl fmt::Display for Summary {
             )?;
             writeln!(
                 f,
-                "  {:<13} solid angle {:.4} sr of 2pi = {:.4} ({source}); largest cell {:.3e} sr \
-                 at theta {:.2}, phi {:.2}",
+                "  {:<13} cells sum {:.4} sr (hemisphere 2pi = 6.2832 sr; {source}); largest \
+                 cell {:.3e} sr at theta {:.2}, phi {:.2}",
                 "",
                 h.solid_angle_sr,
-                std::f64::consts::TAU,
                 h.largest_cell_sr,
                 h.largest_cell_at_deg[0],
                 h.largest_cell_at_deg[1]
             )?;
         }
+        let unit = if self.integral_unit == "1" {
+            String::new()
+        } else {
+            format!(" {}", self.integral_unit)
+        };
         if let Some(rho) = self.rho_dh {
-            writeln!(f, "  rho_dh        {rho:.6} {}", self.integral_unit)?;
+            writeln!(f, "  rho_dh        {}{unit}", significant(rho))?;
         }
         if let Some(tau) = self.tau_dh {
-            writeln!(f, "  tau_dh        {tau:.6} {}", self.integral_unit)?;
+            writeln!(f, "  tau_dh        {}{unit}", significant(tau))?;
         }
         writeln!(f, "  integral      {}", self.integral_note)?;
         if let Some(p) = &self.peak {
