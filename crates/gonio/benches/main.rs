@@ -1,1 +1,65 @@
-fn main() {}
+//! brtf-gonio benchmarks: parse throughput, solid angles and the summary on
+//! the real 4 MB pgII scan `golden_paper.txt` (read from `../shared/data`,
+//! never copied into the repository).
+
+use std::hint::black_box;
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+
+fn golden_path() -> PathBuf {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/data/rgl-epfl-pgII-raw/golden_paper.txt");
+    assert!(
+        path.is_file(),
+        "{} is missing: the benchmark needs the shared data folder beside the repository",
+        path.display()
+    );
+    path
+}
+
+fn parse(c: &mut Criterion) {
+    let path = golden_path();
+    let bytes = std::fs::read(&path).unwrap();
+    let mut group = c.benchmark_group("parse");
+    group.throughput(Throughput::Bytes(bytes.len() as u64));
+    group.bench_function("golden_paper_mountain", |b| {
+        b.iter(|| brtf_gonio::read_bytes(black_box(&bytes), &path).unwrap())
+    });
+    group.bench_function("golden_paper_from_path", |b| {
+        b.iter(|| brtf_gonio::read_path(black_box(&path)).unwrap())
+    });
+    group.finish();
+}
+
+fn write(c: &mut Criterion) {
+    let m = brtf_gonio::read_path(&golden_path()).unwrap();
+    let mut group = c.benchmark_group("write");
+    group.sample_size(20);
+    group.bench_function("golden_paper_mountain_string", |b| {
+        b.iter(|| brtf_gonio::to_mountain_string(black_box(&m)))
+    });
+    group.finish();
+}
+
+fn geometry(c: &mut Criterion) {
+    let m = brtf_gonio::read_path(&golden_path()).unwrap();
+    let mut group = c.benchmark_group("geometry");
+    group.sample_size(10);
+    group.measurement_time(Duration::from_secs(8));
+    group.bench_function("solid_angles_golden_paper_127k", |b| {
+        b.iter(|| brtf_gonio::compute_solid_angles(black_box(&m.samples)))
+    });
+    group.bench_function("summary_golden_paper_127k", |b| {
+        b.iter(|| black_box(&m).summary())
+    });
+    let weights = brtf_gonio::solid_angles(&m);
+    group.bench_function("summary_with_known_weights", |b| {
+        b.iter(|| black_box(&m).summary_with(&weights))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, parse, write, geometry);
+criterion_main!(benches);

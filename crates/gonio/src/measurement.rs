@@ -290,7 +290,13 @@ pub fn normalize_phi_deg(phi_deg: f64) -> f64 {
     if (0.0..360.0).contains(&phi_deg) {
         return phi_deg;
     }
-    let wrapped = phi_deg.rem_euclid(360.0);
+    // (−360, 0) is the common case, (−180, 180] files: the same single
+    // rounding as `rem_euclid`, without its slow `fmod`.
+    let wrapped = if (-360.0..0.0).contains(&phi_deg) {
+        phi_deg + 360.0
+    } else {
+        phi_deg.rem_euclid(360.0)
+    };
     // rem_euclid of a tiny negative number rounds up to exactly 360.
     if wrapped >= 360.0 { 0.0 } else { wrapped }
 }
@@ -529,6 +535,11 @@ mod tests {
         assert_eq!(normalize_phi_deg(360.0), 0.0);
         assert_eq!(normalize_phi_deg(-1e-20), 0.0);
         assert_eq!(normalize_phi_deg(720.5), 0.5);
+        for phi in [-179.99933f64, -0.5, -359.9, -1e-300, -360.0, -123.456789] {
+            let expected = phi.rem_euclid(360.0);
+            let expected = if expected >= 360.0 { 0.0 } else { expected };
+            assert_eq!(normalize_phi_deg(phi), expected, "{phi}");
+        }
     }
 
     #[test]

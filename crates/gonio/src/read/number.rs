@@ -2,7 +2,7 @@
 //!
 //! This module owns the hot loop of the readers: turning a field like
 //! `89.98829` or `-4.574e-06` into an `f64`. Plain decimals with at most 19
-//! significant digits, a mantissa ≤ 2⁵³ and a decimal exponent within ±22
+//! digits, a mantissa ≤ 2⁵³ and a decimal exponent within ±22
 //! take Clinger's exact fast path (one correctly rounded multiplication or
 //! division of two exactly representable numbers), which gives the same
 //! bits as `str::parse::<f64>`. Everything else (long mantissas, large
@@ -41,43 +41,37 @@ pub(crate) fn parse_prefix(bytes: &[u8]) -> Option<(f64, usize)> {
         }
         _ => false,
     };
+    // Digits are accumulated without per-digit checks (wrapping on
+    // overflow); more than 19 digits in all, leading zeros included, falls
+    // back to the standard parser before the mantissa is used.
     let mut mantissa: u64 = 0;
-    let mut digits = 0u32;
-    let mut exponent: i32 = 0;
-    let mut any_digit = false;
+    let int_start = i;
     while let Some(&b) = bytes.get(i) {
-        if !b.is_ascii_digit() {
+        let digit = b.wrapping_sub(b'0');
+        if digit > 9 {
             break;
         }
-        any_digit = true;
-        if mantissa != 0 || b != b'0' {
-            digits += 1;
-            if digits > 19 {
-                return None;
-            }
-        }
-        mantissa = mantissa * 10 + u64::from(b - b'0');
+        mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(digit));
         i += 1;
     }
+    let mut digits = i - int_start;
+    let mut exponent: i32 = 0;
     if bytes.get(i) == Some(&b'.') {
         i += 1;
+        let frac_start = i;
         while let Some(&b) = bytes.get(i) {
-            if !b.is_ascii_digit() {
+            let digit = b.wrapping_sub(b'0');
+            if digit > 9 {
                 break;
             }
-            any_digit = true;
-            if mantissa != 0 || b != b'0' {
-                digits += 1;
-                if digits > 19 {
-                    return None;
-                }
-            }
-            mantissa = mantissa * 10 + u64::from(b - b'0');
-            exponent -= 1;
+            mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(digit));
             i += 1;
         }
+        let frac_digits = i - frac_start;
+        digits += frac_digits;
+        exponent = -i32::try_from(frac_digits).ok()?;
     }
-    if !any_digit {
+    if digits == 0 || digits > 19 {
         return None;
     }
     if let Some(&(b'e' | b'E')) = bytes.get(i) {
@@ -172,6 +166,34 @@ mod tests {
             let ours = parse_f64(text).map(f64::to_bits).ok();
             let std = text.parse::<f64>().map(f64::to_bits).ok();
             assert_eq!(ours, std, "{text:?}");
+        }
+    }
+
+    proptest::proptest! {
+        #[test]
+        fn random_decimals_agree_with_std(
+            sign in "[+-]?",
+            int in "[0-9]{0,22}",
+            frac in proptest::option::of("[0-9]{0,22}"),
+            exp in proptest::option::of("[eE][+-]?[0-9]{1,4}"),
+        ) {
+            let text = format!(
+                "{sign}{int}{}{}",
+                frac.map(|f| format!(".{f}")).unwrap_or_default(),
+                exp.unwrap_or_default()
+            );
+            let ours = parse_f64(&text).map(f64::to_bits).ok();
+            let std = text.parse::<f64>().map(f64::to_bits).ok();
+            proptest::prop_assert_eq!(ours, std, "{}", text);
+        }
+
+        #[test]
+        fn any_f64_round_trips(bits in proptest::prelude::any::<u64>()) {
+            let v = f64::from_bits(bits);
+            proptest::prop_assume!(v.is_finite());
+            for text in [format!("{v}"), format!("{v:e}")] {
+                proptest::prop_assert_eq!(parse_f64(&text).unwrap().to_bits(), bits);
+            }
         }
     }
 }
