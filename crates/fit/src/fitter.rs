@@ -302,7 +302,7 @@ impl FitReport {
 }
 
 /// Samples per start in the multi-start phase.
-const SUBSAMPLE: usize = 3000;
+const SUBSAMPLE: usize = 2000;
 
 /// Fits one incidence.
 pub fn fit_incidence(data: &IncidenceData, config: &FitConfig) -> Result<FitReport, FitError> {
@@ -393,28 +393,28 @@ fn fit_many(
             floor,
             u: u0.clone(),
             evaluations: Cell::new(0),
+            cached_jacobian: Default::default(),
         };
         let (problem, report) = LevenbergMarquardt::new()
-            .with_ftol(1e-12)
-            .with_xtol(1e-12)
+            .with_ftol(1e-10)
+            .with_xtol(1e-10)
             .with_gtol(1e-14)
             .with_patience(patience)
             .minimize(problem);
         evaluations.set(evaluations.get() + problem.evaluations.get());
         // After User/Numerical stops the problem holds the rejected trial
         // point; fall back to the start then.
-        let u = if matches!(
+        if matches!(
             report.termination,
             TerminationReason::User(_) | TerminationReason::Numerical(_)
         ) {
-            u0
+            let cost = problem
+                .residual_vector(&u0)
+                .map_or(f64::INFINITY, |r| 0.5 * r.norm_squared());
+            (u0, cost, report.termination)
         } else {
-            problem.u.clone()
-        };
-        let cost = problem
-            .residual_vector(&u)
-            .map_or(f64::INFINITY, |r| 0.5 * r.norm_squared());
-        (u, cost, report.termination)
+            (problem.u.clone(), report.objective_function, report.termination)
+        }
     };
 
     // Multi-start on a subsample, then the full fit from the best start.
@@ -460,6 +460,7 @@ fn fit_many(
                 floor,
                 u: u.clone(),
                 evaluations: Cell::new(0),
+                cached_jacobian: Default::default(),
             };
             let Some(r) = problem.residual_vector(&u) else {
                 break;
@@ -503,22 +504,27 @@ fn fit_many(
         floor,
         u: u.clone(),
         evaluations: Cell::new(0),
+        cached_jacobian: Default::default(),
     };
     let (p, dp, material, scale) = problem.physical(&u).ok_or_else(|| FitError::Failed {
         origin: label.into(),
         reason: "the solution is not a valid material".into(),
     })?;
     let m_res = problem.n_residuals();
-    let stderr_u = problem
-        .jacobian_matrix(&u)
-        .and_then(|j| {
-            let dof = m_res.saturating_sub(map.len()).max(1) as f64;
-            let s2 = 2.0 * cost / dof;
-            (j.transpose() * &j).try_inverse().map(|inv| {
-                (0..map.len())
-                    .map(|i| (s2 * inv[(i, i)]).max(0.0).sqrt())
-                    .collect::<Vec<f64>>()
-            })
+    let final_pass = problem.evaluate::<true>(&u).ok_or_else(|| FitError::Failed {
+        origin: label.into(),
+        reason: "non-finite residuals or Jacobian at the solution".into(),
+    })?;
+    let rms_rel = final_pass.rms_rel;
+    let jacobian = final_pass.jacobian.expect("requested");
+    let dof = m_res.saturating_sub(map.len()).max(1) as f64;
+    let s2 = 2.0 * cost / dof;
+    let stderr_u = (jacobian.transpose() * &jacobian)
+        .try_inverse()
+        .map(|inv| {
+            (0..map.len())
+                .map(|i| (s2 * inv[(i, i)]).max(0.0).sqrt())
+                .collect::<Vec<f64>>()
         })
         .unwrap_or_else(|| vec![f64::NAN; map.len()]);
 
@@ -565,19 +571,6 @@ fn fit_many(
         ));
     }
 
-    // Unweighted relative RMS, independent of the residual kind.
-    let mut sum = 0.0;
-    let bsdf = brtf_model::Bsdf::new(&material, &config.options);
-    for b in &blocks {
-        for (v, y) in b.views.iter().zip(&b.values) {
-            let f = bsdf.eval(b.light, *v);
-            for ch in 0..channels {
-                let e = (scale * f[ch] - y[ch]) / (y[ch] * y[ch] + floor * floor).sqrt();
-                sum += e * e;
-            }
-        }
-    }
-    let rms_rel = (sum / (n_points * channels).max(1) as f64).sqrt();
     let single = data.len() == 1;
     Ok(FitReport {
         source: label.into(),

@@ -8,7 +8,7 @@ use glam::DVec3;
 use levenberg_marquardt::LeastSquaresProblem;
 use nalgebra::{DMatrix, DVector, Dyn, Owned};
 use serde::{Deserialize, Serialize};
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
 
 /// How a model value m is compared with a measured value y.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
@@ -67,6 +67,7 @@ pub(crate) struct Problem<'a> {
     pub floor: f64,
     pub u: DVector<f64>,
     pub evaluations: Cell<usize>,
+    pub cached_jacobian: RefCell<Option<(DVector<f64>, DMatrix<f64>)>>,
 }
 
 impl Problem<'_> {
@@ -97,50 +98,80 @@ impl Problem<'_> {
     }
 
     pub(crate) fn residual_vector(&self, u: &DVector<f64>) -> Option<DVector<f64>> {
-        let (_, _, material, scale) = self.physical(u)?;
-        let bsdf = Bsdf::new(&material, &self.options);
-        let mut r = DVector::zeros(self.n_residuals());
-        let mut row = 0;
-        for block in self.blocks {
-            for ((v, y), k) in block.views.iter().zip(&block.values).zip(&block.factors) {
-                let f = bsdf.eval(block.light, *v);
-                for ch in 0..self.channels {
-                    r[row] = self.residual(scale * f[ch], y[ch], k[ch]).0;
-                    row += 1;
-                }
-            }
-        }
-        self.evaluations.set(self.evaluations.get() + 1);
-        r.iter().all(|x| x.is_finite()).then_some(r)
+        self.evaluate::<false>(u).map(|e| e.residuals)
     }
 
     pub(crate) fn jacobian_matrix(&self, u: &DVector<f64>) -> Option<DMatrix<f64>> {
+        self.evaluate::<true>(u).and_then(|e| e.jacobian)
+    }
+
+    /// Residuals, and with `JACOBIAN` the Jacobian on the same pass (one
+    /// BSDF evaluation per sample serves both), plus the unweighted RMS of
+    /// `(m − y)/sqrt(y² + floor²)` reported as `rms_rel`.
+    pub(crate) fn evaluate<const JACOBIAN: bool>(&self, u: &DVector<f64>) -> Option<Evaluation> {
         let (_, dp, material, scale) = self.physical(u)?;
         let bsdf = Bsdf::new(&material, &self.options);
         let n = self.map.len();
         let m = self.n_residuals();
-        let mut jac = DMatrix::zeros(m, n);
+        let columns: Vec<(Target, f64)> =
+            self.map.slots.iter().zip(&dp).map(|(s, &d)| (s.target, d)).collect();
+        let mut residuals = DVector::zeros(m);
+        let mut jac = if JACOBIAN { DMatrix::zeros(m, n) } else { DMatrix::zeros(0, 0) };
+        let mut jac_columns: Vec<&mut [f64]> = if JACOBIAN {
+            jac.as_mut_slice().chunks_mut(m).collect()
+        } else {
+            Vec::new()
+        };
         let mut grad = Gradient::default();
         let mut row = 0;
+        let mut sum_rel = 0.0;
+        let floor2 = self.floor * self.floor;
         for block in self.blocks {
             for ((v, y), k) in block.views.iter().zip(&block.values).zip(&block.factors) {
-                let f = bsdf.eval_with_gradient(block.light, *v, &mut grad);
+                let f = if JACOBIAN {
+                    bsdf.eval_with_gradient(block.light, *v, &mut grad)
+                } else {
+                    bsdf.eval(block.light, *v)
+                };
                 for ch in 0..self.channels {
-                    let (_, dr_dm) = self.residual(scale * f[ch], y[ch], k[ch]);
-                    for (j, slot) in self.map.slots.iter().enumerate() {
-                        let dm_dp = match slot.target {
-                            Target::Arg(a) => scale * grad.d[a][ch],
-                            Target::Gray => scale * (grad.d[0][ch] + grad.d[1][ch] + grad.d[2][ch]),
-                            Target::Scale => f[ch],
-                        };
-                        jac[(row, j)] = dr_dm * dm_dp * dp[j];
+                    let model = scale * f[ch];
+                    let (r, dr_dm) = self.residual(model, y[ch], k[ch]);
+                    residuals[row] = r;
+                    let e = model - y[ch];
+                    sum_rel += e * e / (y[ch] * y[ch] + floor2);
+                    if JACOBIAN {
+                        for (column, &(target, dp_du)) in jac_columns.iter_mut().zip(&columns) {
+                            let dm_dp = match target {
+                                Target::Arg(a) => scale * grad.d[a][ch],
+                                Target::Gray => {
+                                    scale * (grad.d[0][ch] + grad.d[1][ch] + grad.d[2][ch])
+                                }
+                                Target::Scale => f[ch],
+                            };
+                            column[row] = dr_dm * dm_dp * dp_du;
+                        }
                     }
                     row += 1;
                 }
             }
         }
-        jac.iter().all(|x| x.is_finite()).then_some(jac)
+        drop(jac_columns);
+        self.evaluations.set(self.evaluations.get() + 1);
+        let finite = residuals.iter().all(|x| x.is_finite())
+            && (!JACOBIAN || jac.iter().all(|x| x.is_finite()));
+        finite.then(|| Evaluation {
+            residuals,
+            jacobian: JACOBIAN.then_some(jac),
+            rms_rel: (sum_rel / m.max(1) as f64).sqrt(),
+        })
     }
+}
+
+/// One pass over the data.
+pub(crate) struct Evaluation {
+    pub residuals: DVector<f64>,
+    pub jacobian: Option<DMatrix<f64>>,
+    pub rms_rel: f64,
 }
 
 impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
@@ -156,11 +187,20 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
         self.u.clone()
     }
 
+    /// Computes the Jacobian on the same pass and keeps it: LM asks for
+    /// the Jacobian at the last accepted point, which is almost always the
+    /// point of the last residual call.
     fn residuals(&self) -> Option<DVector<f64>> {
-        self.residual_vector(&self.u)
+        let e = self.evaluate::<true>(&self.u)?;
+        *self.cached_jacobian.borrow_mut() = e.jacobian.map(|j| (self.u.clone(), j));
+        Some(e.residuals)
     }
 
     fn jacobian(&self) -> Option<DMatrix<f64>> {
-        self.jacobian_matrix(&self.u)
+        let cached = self.cached_jacobian.borrow_mut().take();
+        match cached {
+            Some((u, j)) if u == self.u => Some(j),
+            _ => self.jacobian_matrix(&self.u),
+        }
     }
 }
