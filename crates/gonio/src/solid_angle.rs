@@ -289,6 +289,17 @@ fn circumcenter(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> [f64; 2] {
 /// counter-clockwise polygons).
 pub fn disk_polygon_area(polygon: &[[f64; 2]], radius: f64) -> f64 {
     let n = polygon.len();
+    let r2 = radius * radius;
+    if polygon.iter().all(|p| p[0] * p[0] + p[1] * p[1] <= r2) {
+        // The disk is convex: a polygon with every vertex inside is inside.
+        return 0.5
+            * (0..n)
+                .map(|i| {
+                    let (p, q) = (polygon[i], polygon[(i + 1) % n]);
+                    p[0] * q[1] - p[1] * q[0]
+                })
+                .sum::<f64>();
+    }
     (0..n)
         .map(|i| disk_triangle_area(polygon[i], polygon[(i + 1) % n], radius))
         .sum()

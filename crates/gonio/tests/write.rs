@@ -166,7 +166,11 @@ fn cross_format_writes() {
     // .mpc → Mountain keeps the old header as comments and the samples.
     let mpc = read_path(&fixture_path(MPC_FIXTURE)).unwrap();
     let text = to_mountain_string(&mpc);
-    assert!(text.contains("\n#30\n"), "bare value kept as a comment");
+    assert!(
+        text.contains("\n#>30\n"),
+        "bare value kept as an inert comment"
+    );
+    assert!(text.starts_with("#>using beam file: pab-aluA-st1:beam.mpc.refint 0.063626\n"));
     let back = read_str(&text, "from-mpc.txt").unwrap();
     assert_eq!(back.format, SourceFormat::Mountain);
     assert_eq!(back.quantity, Quantity::Bsdf);

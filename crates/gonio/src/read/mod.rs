@@ -5,7 +5,7 @@
 //! share: the text check (empty, NUL bytes, invalid UTF-8), the line walk
 //! with 1-based line numbers, number fields with the sentinel rule, and the
 //! incidence found in a file name (`…:+15+0.mpc`). The format specifics
-//! live in [`mpc`] and [`mountain`].
+//! live in the private submodules `mpc` and `mountain`.
 //!
 //! Input is read in one go and parsed from the byte buffer; rows are split
 //! on ASCII whitespace (spaces or tabs) and CRLF line ends are accepted.

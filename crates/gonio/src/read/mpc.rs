@@ -36,7 +36,8 @@ enum Label {
 
 /// Classifies a header body (text after `#`) that ends in `:`.
 fn classify_label(body_lower: &str) -> Label {
-    let incident = body_lower.contains("incident") || body_lower.contains("incidence");
+    // `incident angle theta [degree]:`; "incidence" starts the same way.
+    let incident = body_lower.trim_start().starts_with("incident");
     if incident && body_lower.contains("theta") {
         Label::IncidentTheta
     } else if incident && body_lower.contains("phi") {

@@ -5,12 +5,13 @@
 //! bit-identical `f64`s), NaN is written as the `9.9e+37` sentinel, and
 //! files are written to a temporary file in the target directory and then
 //! renamed over the target, so a crash never leaves a half-written file.
-//! The format specifics live in [`mpc`] and [`mountain`].
+//! The format specifics live in the private submodules `mpc` and
+//! `mountain`.
 //!
 //! Header lines read from a file of the same format are written back
 //! verbatim unless the value they carry changed (then that one line is
 //! regenerated in place); lines from a file of the other format are kept as
-//! `#` comments.
+//! inert `#>` comments that neither reader interprets.
 
 pub(crate) mod mountain;
 pub(crate) mod mpc;
@@ -59,6 +60,13 @@ pub fn to_mountain_string(measurement: &Measurement) -> String {
 /// (the format holds a one-channel BSDF only).
 pub fn to_mpc_string(measurement: &Measurement) -> Result<String, String> {
     mpc::render(measurement)
+}
+
+/// A header line from a file of the other format, made inert: `#>` plus the
+/// line without its leading `#`, so no reader takes it for one of its keys.
+pub(crate) fn foreign_header_line(line: &str) -> String {
+    let trimmed = line.trim_start();
+    format!("#>{}", trimmed.strip_prefix('#').unwrap_or(trimmed))
 }
 
 /// Appends a number in shortest round-trip form; NaN becomes the sentinel.

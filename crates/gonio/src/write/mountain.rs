@@ -62,11 +62,7 @@ fn header_lines(m: &Measurement) -> Vec<String> {
     for line in &m.header {
         if m.format != SourceFormat::Mountain {
             // Foreign header lines survive as comments.
-            out.push(if line.trim_start().starts_with('#') {
-                line.clone()
-            } else {
-                format!("#{line}")
-            });
+            out.push(super::foreign_header_line(line));
             continue;
         }
         let Some((key, rest)) = split_key(line) else {

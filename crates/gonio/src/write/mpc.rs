@@ -21,7 +21,8 @@ enum Label {
 }
 
 fn classify(body_lower: &str) -> Label {
-    let incident = body_lower.contains("incident") || body_lower.contains("incidence");
+    // `incident angle theta [degree]:`; "incidence" starts the same way.
+    let incident = body_lower.trim_start().starts_with("incident");
     if incident && body_lower.contains("theta") {
         Label::Theta
     } else if incident && body_lower.contains("phi") {
@@ -64,11 +65,7 @@ fn header_lines(m: &Measurement) -> (Vec<String>, String) {
 
     for line in &m.header {
         if m.format != SourceFormat::Mpc {
-            out.push(if line.trim_start().starts_with('#') {
-                line.clone()
-            } else {
-                format!("#{line}")
-            });
+            out.push(super::foreign_header_line(line));
             continue;
         }
         let trimmed = line.trim();
