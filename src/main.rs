@@ -22,6 +22,12 @@ enum Command {
     Albedo(cmd::albedo::AlbedoArgs),
     /// Summarise measurement files (.mpc or Mountain).
     Info(cmd::info::InfoArgs),
+    /// Write Radiance materials (static and θ_in-dependent) from a fit folder.
+    Export(cmd::export::ExportArgs),
+    /// Render with brtf's own ray tracer: a virtual gonio-photometer or an image.
+    Render(cmd::render::RenderArgs),
+    /// Check a fit by rendering every incidence through the virtual gonio-photometer.
+    Check(cmd::check::CheckArgs),
 }
 
 fn main() {
@@ -30,6 +36,9 @@ fn main() {
         Command::Eval(args) => cmd::eval::run(args),
         Command::Albedo(args) => cmd::albedo::run(args),
         Command::Info(args) => cmd::info::run(args),
+        Command::Export(args) => cmd::export::run(args),
+        Command::Render(args) => cmd::render::run(args),
+        Command::Check(args) => cmd::check::run(args),
     };
     if let Err(err) = result {
         eprintln!("brtf: error: {err:#}");

@@ -1,5 +1,8 @@
 //! One module per subcommand.
 pub mod albedo;
+pub mod check;
 pub mod eval;
+pub mod export;
 pub mod info;
 pub mod material;
+pub mod render;

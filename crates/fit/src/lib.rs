@@ -20,6 +20,7 @@ mod data;
 mod fitter;
 mod params;
 mod problem;
+mod result;
 mod table;
 
 /// Serialises a material type as its Radiance name.
@@ -45,4 +46,5 @@ pub use fitter::{
 };
 pub use params::{MAX_ROUGHNESS, MIN_ROUGHNESS, ParamMap, Slot, Target};
 pub use problem::ResidualKind;
+pub use result::{FitResult, InputFile, Provenance};
 pub use table::{Interpolation, ParamTable, TableError, TableLookup};

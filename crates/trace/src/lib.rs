@@ -1,0 +1,1 @@
+//! brtf-trace: a minimal ray tracer (being built).
