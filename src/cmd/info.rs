@@ -32,6 +32,12 @@ struct FileSummary {
 pub fn run(args: InfoArgs) -> anyhow::Result<()> {
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
+    write_report(&args, &mut out)
+}
+
+/// Summarises every file of `args` into `out`. Stops at the first file that
+/// cannot be read, with the file named in the error.
+fn write_report(args: &InfoArgs, out: &mut impl Write) -> anyhow::Result<()> {
     let mut entries = Vec::with_capacity(args.files.len());
     for (i, path) in args.files.iter().enumerate() {
         let measurement = brtf_gonio::read_path(path)
@@ -51,8 +57,55 @@ pub fn run(args: InfoArgs) -> anyhow::Result<()> {
         }
     }
     if args.json {
-        serde_json::to_writer_pretty(&mut out, &entries).context("writing JSON")?;
+        serde_json::to_writer_pretty(&mut *out, &entries).context("writing JSON")?;
         writeln!(out)?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn fixture() -> PathBuf {
+        PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("crates/gonio/tests/fixtures/pab-aluA-st1:+30+0.mpc")
+    }
+
+    fn report(files: Vec<PathBuf>, json: bool) -> anyhow::Result<String> {
+        let mut out = Vec::new();
+        write_report(&InfoArgs { files, json }, &mut out)?;
+        Ok(String::from_utf8(out).unwrap())
+    }
+
+    #[test]
+    fn text_report_names_the_file_and_the_quantity() {
+        let text = report(vec![fixture(), fixture()], false).unwrap();
+        assert_eq!(text.matches("pab-aluA-st1:+30+0.mpc\n").count(), 2);
+        assert!(text.contains("theta_in = 30 deg, phi_in = 0 deg (from the header)"));
+        assert!(text.contains("quantity      BSDF [1/sr] (CIE-Y)"));
+        assert!(text.contains("6 (front 0, back 6); 5 negative, 0 not available"));
+    }
+
+    #[test]
+    fn json_report_is_an_array_of_summaries() {
+        let text = report(vec![fixture()], true).unwrap();
+        let value: serde_json::Value = serde_json::from_str(&text).unwrap();
+        let entry = &value.as_array().unwrap()[0];
+        assert!(entry["file"].as_str().unwrap().ends_with(":+30+0.mpc"));
+        assert_eq!(entry["quantity"], "BSDF");
+        assert_eq!(entry["back"]["count"], 6);
+        assert_eq!(entry["beam"]["integral"], 0.063626);
+    }
+
+    #[test]
+    fn unreadable_files_are_named_in_the_error() {
+        let err = report(vec![PathBuf::from("/nonexistent/scan.txt")], false).unwrap_err();
+        let message = format!("{err:#}");
+        assert!(
+            message.contains("reading measurement /nonexistent/scan.txt"),
+            "{message}"
+        );
+        assert!(message.contains("No such file"), "{message}");
+    }
 }
