@@ -26,7 +26,8 @@ pub struct HemisphereSummary {
     pub phi_range_deg: [f64; 2],
     /// Samples with a negative value (noise floor).
     pub negatives: usize,
-    /// Samples with a "not available" value (`9.9e+37` in the file).
+    /// Samples with a "not available" value (`9.9e+37` in the file) in
+    /// any used channel.
     pub unavailable: usize,
     /// Σ ΔΩ of the samples, sr (2π ≈ 6.2832 when the hemisphere is covered).
     pub solid_angle_sr: f64,
@@ -158,6 +159,7 @@ impl Measurement {
         let mut theta = [f64::INFINITY, f64::NEG_INFINITY];
         let mut phi = [f64::INFINITY, f64::NEG_INFINITY];
         let mut negatives = 0;
+        let mut unavailable = 0;
         let mut largest = (f64::NEG_INFINITY, [f64::NAN; 2]);
         for (s, &w) in self.samples.iter().zip(weights) {
             if s.hemisphere() != hemisphere {
@@ -168,6 +170,9 @@ impl Measurement {
             if s.values[..n].iter().any(|&v| v < 0.0) {
                 negatives += 1;
             }
+            if !s.is_available(self.channels) {
+                unavailable += 1;
+            }
             if w > largest.0 {
                 largest = (w, [s.theta_deg, s.phi_deg]);
             }
@@ -177,7 +182,7 @@ impl Measurement {
             theta_range_deg: theta,
             phi_range_deg: phi,
             negatives,
-            unavailable: integral.samples_skipped,
+            unavailable,
             solid_angle_sr: integral.solid_angle_sr,
             largest_cell_sr: largest.0,
             largest_cell_at_deg: largest.1,

@@ -79,3 +79,31 @@ fn mpc_summary_uses_file_weights_and_reports_the_back() {
             .contains("beam file     pab-aluA-st1:beam.mpc.refint")
     );
 }
+
+#[test]
+fn xyz_summary_counts_any_unavailable_channel_and_integrates_y() {
+    use brtf_gonio::{Channels, Incidence, Measurement, Quantity, Sample, SourceFormat};
+    let mut samples = crate::common::grid(5.0, 10.0, false, 0.0);
+    for s in &mut samples {
+        s.values = [0.1, 1.0 / std::f64::consts::PI, 0.3];
+    }
+    samples[10].values[0] = f64::NAN; // X missing, Y fine
+    samples.push(Sample::new(120.0, 0.0, [0.0, -0.5, 0.0]));
+    let m = Measurement::new(
+        SourceFormat::Mountain,
+        Incidence::new(10.0, 0.0),
+        Quantity::Bsdf,
+        Channels::Xyz,
+        samples,
+    );
+    let s = m.summary();
+    assert_eq!(s.unavailable, 1);
+    assert_eq!(s.front.as_ref().unwrap().unavailable, 1);
+    assert_eq!(s.back.as_ref().unwrap().negatives, 1);
+    assert_relative_eq!(s.rho_dh.unwrap(), 1.0, max_relative = 0.01);
+    assert!(
+        s.tau_dh.unwrap() < 0.0,
+        "noise integrates to a negative tau"
+    );
+    assert_eq!(s.peak.unwrap().value, 1.0 / std::f64::consts::PI);
+}
