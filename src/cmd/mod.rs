@@ -3,6 +3,8 @@ pub mod albedo;
 pub mod check;
 pub mod eval;
 pub mod export;
+pub mod fit;
 pub mod info;
 pub mod material;
+pub mod output;
 pub mod render;
