@@ -342,6 +342,24 @@ fn theta_out_of_range() {
 }
 
 #[test]
+fn incidence_out_of_range() {
+    let text = "#intheta 200\n#inphi 0\n#format: theta phi BSDF\n10 20 1\n";
+    expect_error(read_str(text, "big.txt"), "big.txt", 1, |k| {
+        matches!(
+            k,
+            ParseErrorKind::AngleOutOfRange {
+                what: "theta_in",
+                ..
+            }
+        )
+    });
+    // A signed in-plane angle flips the azimuth.
+    let text = "#intheta -20\n#inphi 0\n#format: theta phi BSDF\n10 20 1\n";
+    let m = read_str(text, "neg.txt").unwrap();
+    assert_eq!((m.incidence.theta_deg, m.incidence.phi_deg), (20.0, 180.0));
+}
+
+#[test]
 fn missing_incidence() {
     let text = "#format: theta phi BSDF\n10 20 1\n";
     let msg = expect_error(read_str(text, "noinc.txt"), "noinc.txt", 2, |k| {

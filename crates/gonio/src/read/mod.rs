@@ -433,6 +433,19 @@ pub(crate) fn resolve_incidence(
             return Err(parse_error(name, line, kind));
         }
     };
+    if !(-180.0..=180.0).contains(&theta) {
+        let kind = ParseErrorKind::AngleOutOfRange {
+            what: "theta_in",
+            value: theta,
+            min: -180.0,
+            max: 180.0,
+        };
+        return Err(parse_error(
+            name,
+            header_theta.map_or(line, |a| a.line),
+            kind,
+        ));
+    }
     let (theta, phi) = normalize_incidence(theta, phi);
     let origin = if header_theta.is_some() && header_phi.is_some() {
         IncidenceOrigin::Header
