@@ -22,6 +22,8 @@ enum Command {
     Albedo(cmd::albedo::AlbedoArgs),
     /// Summarise measurement files (.mpc or Mountain).
     Info(cmd::info::InfoArgs),
+    /// Write synthetic measurement files with realistic instrument effects.
+    Synth(cmd::synth::SynthArgs),
     /// Fit a material to measurement files, one incidence each.
     Fit(cmd::fit::FitArgs),
     /// Write Radiance materials (static and θ_in-dependent) from a fit folder.
@@ -38,6 +40,7 @@ fn main() {
         Command::Eval(args) => cmd::eval::run(args),
         Command::Albedo(args) => cmd::albedo::run(args),
         Command::Info(args) => cmd::info::run(args),
+        Command::Synth(args) => cmd::synth::run(args),
         Command::Fit(args) => cmd::fit::run(args),
         Command::Export(args) => cmd::export::run(args),
         Command::Render(args) => cmd::render::run(args),

@@ -52,7 +52,7 @@ pub struct FitArgs {
     )]
     pub orientation: Vec<f64>,
     /// How model and data are compared.
-    #[arg(long, value_enum, default_value_t = ResidualArg::Relative)]
+    #[arg(long, value_enum, default_value_t = ResidualArg::Absolute)]
     pub residual: ResidualArg,
     /// Floor for relative/log residuals, in the data's unit [default: 10% of the 10th percentile].
     #[arg(long)]

@@ -8,3 +8,4 @@ pub mod info;
 pub mod material;
 pub mod output;
 pub mod render;
+pub mod synth;

@@ -33,7 +33,11 @@ pub fn bench_data() -> (Material, IncidenceData) {
             let v = direction(theta, phi);
             let f = bsdf.eval(l, v)[1] * (1.0 + 0.02 * gauss());
             let weight = theta.to_radians().sin();
-            samples.push(FitSample { view: v, value: [f, 0.0, 0.0], weight });
+            samples.push(FitSample {
+                view: v,
+                value: [f, 0.0, 0.0],
+                weight,
+            });
         }
     }
     let data = IncidenceData {
@@ -50,7 +54,9 @@ pub fn bench_data() -> (Material, IncidenceData) {
 
 fn write_peer_data(data: &IncidenceData) {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../target");
-    let Ok(file) = std::fs::File::create(dir.join("fit-bench-metal.csv")) else { return };
+    let Ok(file) = std::fs::File::create(dir.join("fit-bench-metal.csv")) else {
+        return;
+    };
     let mut out = std::io::BufWriter::new(file);
     let _ = writeln!(out, "theta_in,phi_in,vx,vy,vz,value,weight");
     for s in &data.samples {
@@ -79,10 +85,14 @@ fn bench_fit(c: &mut Criterion) {
     );
     let mut group = c.benchmark_group("fit");
     group.sample_size(10);
-    group.bench_function("metal_120k_multistart", |b| b.iter(|| fit_incidence(&data, &config).unwrap()));
+    group.bench_function("metal_120k_multistart", |b| {
+        b.iter(|| fit_incidence(&data, &config).unwrap())
+    });
     let mut single = config.clone();
     single.multistart = false;
-    group.bench_function("metal_120k_single_start", |b| b.iter(|| fit_incidence(&data, &single).unwrap()));
+    group.bench_function("metal_120k_single_start", |b| {
+        b.iter(|| fit_incidence(&data, &single).unwrap())
+    });
     group.finish();
 }
 

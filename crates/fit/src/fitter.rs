@@ -54,7 +54,7 @@ pub struct FitConfig {
 }
 
 impl FitConfig {
-    /// Defaults for `kind`: radiance variant, RGB, relative residuals, multi-start.
+    /// Defaults for `kind`: radiance variant, RGB, absolute residuals, multi-start.
     pub fn new(kind: MaterialKind) -> FitConfig {
         FitConfig {
             kind,
@@ -62,7 +62,7 @@ impl FitConfig {
             orientation: [1.0, 0.0, 0.0],
             gray: false,
             free_scale: false,
-            residual: ResidualKind::Relative,
+            residual: ResidualKind::Absolute,
             floor: None,
             loss: RobustLoss::None,
             multistart: true,
@@ -413,7 +413,11 @@ fn fit_many(
                 .map_or(f64::INFINITY, |r| 0.5 * r.norm_squared());
             (u0, cost, report.termination)
         } else {
-            (problem.u.clone(), report.objective_function, report.termination)
+            (
+                problem.u.clone(),
+                report.objective_function,
+                report.termination,
+            )
         }
     };
 
@@ -511,10 +515,12 @@ fn fit_many(
         reason: "the solution is not a valid material".into(),
     })?;
     let m_res = problem.n_residuals();
-    let final_pass = problem.evaluate::<true>(&u).ok_or_else(|| FitError::Failed {
-        origin: label.into(),
-        reason: "non-finite residuals or Jacobian at the solution".into(),
-    })?;
+    let final_pass = problem
+        .evaluate::<true>(&u)
+        .ok_or_else(|| FitError::Failed {
+            origin: label.into(),
+            reason: "non-finite residuals or Jacobian at the solution".into(),
+        })?;
     let rms_rel = final_pass.rms_rel;
     let jacobian = final_pass.jacobian.expect("requested");
     let dof = m_res.saturating_sub(map.len()).max(1) as f64;

@@ -13,11 +13,15 @@ use std::cell::{Cell, RefCell};
 /// How a model value m is compared with a measured value y.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 pub enum ResidualKind {
-    /// `m − y`: dominated by the specular peak.
+    /// `m − y`, weighted by solid angle: the squared error integrated over
+    /// the sphere. The peak counts most, and the fitted lobe keeps the
+    /// data's energy even when the model cannot follow the data's shape.
+    /// The default.
+    #[default]
     Absolute,
     /// `(m − y) / sqrt(y² + floor²)`: every direction counts alike; right
-    /// for multiplicative noise on top of a noise floor. The default.
-    #[default]
+    /// for multiplicative noise on top of a noise floor when the model can
+    /// describe the data exactly.
     Relative,
     /// `ln(m + floor) − ln(max(y, 0) + floor)`.
     Log,
@@ -113,10 +117,19 @@ impl Problem<'_> {
         let bsdf = Bsdf::new(&material, &self.options);
         let n = self.map.len();
         let m = self.n_residuals();
-        let columns: Vec<(Target, f64)> =
-            self.map.slots.iter().zip(&dp).map(|(s, &d)| (s.target, d)).collect();
+        let columns: Vec<(Target, f64)> = self
+            .map
+            .slots
+            .iter()
+            .zip(&dp)
+            .map(|(s, &d)| (s.target, d))
+            .collect();
         let mut residuals = DVector::zeros(m);
-        let mut jac = if JACOBIAN { DMatrix::zeros(m, n) } else { DMatrix::zeros(0, 0) };
+        let mut jac = if JACOBIAN {
+            DMatrix::zeros(m, n)
+        } else {
+            DMatrix::zeros(0, 0)
+        };
         let mut jac_columns: Vec<&mut [f64]> = if JACOBIAN {
             jac.as_mut_slice().chunks_mut(m).collect()
         } else {

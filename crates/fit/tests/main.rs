@@ -136,7 +136,11 @@ fn recovers_noisy_metal_within_three_standard_errors() {
     let m = material(MaterialKind::Metal, &truth);
     for (k, theta) in [0.0, 15.0, 30.0, 45.0, 60.0].into_iter().enumerate() {
         let data = synth(&m, theta, 0.0, 0.02, 1000 + k as u64);
-        let report = fit_incidence(&data, &FitConfig::new(MaterialKind::Metal)).unwrap();
+        // Multiplicative noise: relative residuals are homoscedastic, so
+        // s²(JᵀJ)⁻¹ is the right covariance.
+        let mut config = FitConfig::new(MaterialKind::Metal);
+        config.residual = brtf_fit::ResidualKind::Relative;
+        let report = fit_incidence(&data, &config).unwrap();
         for (p, want) in report.params.iter().zip(truth) {
             assert!(
                 (p.value - want).abs() <= 3.0 * p.stderr,

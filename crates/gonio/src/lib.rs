@@ -48,6 +48,7 @@ pub mod read;
 pub mod select;
 pub mod solid_angle;
 pub mod summary;
+pub mod synth;
 pub mod write;
 
 pub use convert::{Converted, GRAZING_COS_LIMIT};

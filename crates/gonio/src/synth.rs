@@ -1,0 +1,381 @@
+//! Synthetic measurements with realistic instrument effects.
+//!
+//! This module owns `brtf synth`'s physics-free part of the instrument:
+//! where the detector samples (a coarse hemisphere grid plus a dense patch
+//! around the specular peak, as adaptive gonio-photometers do), averaging
+//! over the source and detector apertures, noise (multiplicative plus a
+//! floor), the blind spot around the incident beam, a holder-shadow gap,
+//! and noise-only back rows for opaque samples. The ground truth is any
+//! brtf-model material, or a GGX (Cook-Torrance) conductor that Radiance's
+//! Gaussian lobe cannot fit exactly, for honest model-mismatch tests.
+//! Everything is seeded and deterministic.
+
+use crate::measurement::{
+    Channels, Incidence, IncidenceOrigin, Measurement, Quantity, Sample, SourceFormat,
+};
+use crate::solid_angle::compute_solid_angles;
+use brtf_model::{Bsdf, direction};
+use glam::DVec3;
+use std::f64::consts::PI;
+
+/// What the synthetic sample really is.
+#[derive(Debug, Clone, Copy)]
+pub enum GroundTruth {
+    /// A brtf-model material, evaluated with its options.
+    Model(Bsdf),
+    /// A GGX conductor: Trowbridge-Reitz microfacets, Schlick Fresnel,
+    /// separable Smith shadowing, plus a Lambertian base.
+    Ggx {
+        /// Normal-incidence Fresnel reflectance per channel.
+        f0: [f64; 3],
+        /// GGX roughness α (the slope-distribution width).
+        alpha: f64,
+        /// Lambertian reflectance per channel.
+        diffuse: [f64; 3],
+    },
+}
+
+impl GroundTruth {
+    /// BSDF (1/sr, no cosine) for light `l` and view `v`.
+    pub fn eval(&self, l: DVec3, v: DVec3) -> [f64; 3] {
+        match self {
+            GroundTruth::Model(bsdf) => bsdf.eval(l, v),
+            GroundTruth::Ggx { f0, alpha, diffuse } => ggx(*f0, *alpha, *diffuse, l, v),
+        }
+    }
+
+    /// The lobe's angular width in radians, to size the dense patch.
+    pub fn lobe_width(&self) -> f64 {
+        match self {
+            GroundTruth::Model(bsdf) => {
+                let a = bsdf.material().args();
+                let alpha = if bsdf.kind().is_anisotropic() {
+                    a[4].max(a[5])
+                } else {
+                    a[4]
+                };
+                2.0 * alpha.max(0.005)
+            }
+            GroundTruth::Ggx { alpha, .. } => 2.0 * alpha.max(0.005),
+        }
+    }
+
+    /// True when the truth transmits light.
+    pub fn transmits(&self) -> bool {
+        match self {
+            GroundTruth::Model(bsdf) => bsdf.kind().is_transmitting(),
+            GroundTruth::Ggx { .. } => false,
+        }
+    }
+}
+
+fn ggx(f0: [f64; 3], alpha: f64, diffuse: [f64; 3], l: DVec3, v: DVec3) -> [f64; 3] {
+    if l.z <= 0.0 || v.z <= 0.0 {
+        return [0.0; 3];
+    }
+    let h = (l + v).normalize();
+    let a2 = alpha * alpha;
+    let cos_h = h.z;
+    let tan2_h = (1.0 - cos_h * cos_h) / (cos_h * cos_h);
+    let d = a2 / (PI * cos_h.powi(4) * (a2 + tan2_h).powi(2));
+    let smith = |c: f64| {
+        let tan2 = (1.0 - c * c) / (c * c);
+        2.0 / (1.0 + (1.0 + a2 * tan2).sqrt())
+    };
+    let g = smith(l.z) * smith(v.z);
+    let schlick = (1.0 - v.dot(h)).clamp(0.0, 1.0).powi(5);
+    let mut f = [0.0; 3];
+    for c in 0..3 {
+        let fresnel = f0[c] + (1.0 - f0[c]) * schlick;
+        f[c] = diffuse[c] / PI + fresnel * d * g / (4.0 * l.z * v.z);
+    }
+    f
+}
+
+/// The instrument's imperfections.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Instrument {
+    /// Full apex angle of the source (beam) cone, degrees.
+    pub source_aperture_deg: f64,
+    /// Full apex angle of the detector cone, degrees.
+    pub detector_aperture_deg: f64,
+    /// Relative (multiplicative) noise, 1σ.
+    pub noise_relative: f64,
+    /// Additive noise floor, 1σ, in 1/sr.
+    pub noise_floor: f64,
+    /// Half-angle of the blind spot around the incident beam, degrees.
+    pub blind_spot_deg: f64,
+    /// Remove a holder-shadow gap: near-grazing directions (θ > 80°)
+    /// within ±10° of φ_in + 90°, where the sample holder's arm stands.
+    pub holder_gap: bool,
+    /// Add noise-only rows on the back hemisphere of an opaque sample.
+    pub back_rows: bool,
+    /// Aperture-averaging rays per cone (per axis: n × n).
+    pub aperture_rays: usize,
+}
+
+impl Default for Instrument {
+    fn default() -> Self {
+        Instrument {
+            source_aperture_deg: 0.5,
+            detector_aperture_deg: 0.75,
+            noise_relative: 0.02,
+            noise_floor: 1e-3,
+            blind_spot_deg: 3.0,
+            holder_gap: true,
+            back_rows: true,
+            aperture_rays: 3,
+        }
+    }
+}
+
+/// Where the detector samples.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Layout {
+    /// Spacing of the coarse grid, degrees.
+    pub coarse_step_deg: f64,
+    /// Spacing of the dense patch around the peak, degrees.
+    pub fine_step_deg: f64,
+    /// Largest θ_out sampled, degrees.
+    pub max_theta_deg: f64,
+}
+
+impl Default for Layout {
+    fn default() -> Self {
+        Layout {
+            coarse_step_deg: 2.5,
+            fine_step_deg: 0.5,
+            max_theta_deg: 88.0,
+        }
+    }
+}
+
+/// Everything that defines one synthetic file.
+#[derive(Debug, Clone)]
+pub struct SynthSpec {
+    /// The truth.
+    pub truth: GroundTruth,
+    /// Incident direction.
+    pub incidence: Incidence,
+    /// Instrument effects.
+    pub instrument: Instrument,
+    /// Sampling layout.
+    pub layout: Layout,
+    /// 1 (CIE-Y, the mean of the three channels) or 3 values per row.
+    pub channels: Channels,
+    /// Seed of the noise (the layout itself is deterministic).
+    pub seed: u64,
+    /// `#sample_name`.
+    pub sample_name: String,
+}
+
+/// SplitMix64: a tiny, well-mixed seeded generator.
+struct Rng(u64);
+
+impl Rng {
+    fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    fn uniform(&mut self) -> f64 {
+        ((self.next_u64() >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+    }
+
+    fn normal(&mut self) -> f64 {
+        let (a, b) = (self.uniform(), self.uniform());
+        (-2.0 * a.ln()).sqrt() * (2.0 * PI * b).cos()
+    }
+}
+
+/// Unit vectors perpendicular to `d`.
+fn frame(d: DVec3) -> (DVec3, DVec3) {
+    let helper = if d.z.abs() < 0.9 { DVec3::Z } else { DVec3::X };
+    let e1 = helper.cross(d).normalize();
+    (e1, d.cross(e1))
+}
+
+/// Deterministic stratified directions filling a cone of full apex angle
+/// `aperture_deg` around `d` (uniform in solid angle), n × n of them.
+fn cone_directions(d: DVec3, aperture_deg: f64, n: usize) -> Vec<DVec3> {
+    if aperture_deg <= 0.0 || n <= 1 {
+        return vec![d];
+    }
+    let cos_max = (0.5 * aperture_deg.to_radians()).cos();
+    let (e1, e2) = frame(d);
+    let mut out = Vec::with_capacity(n * n);
+    for i in 0..n {
+        for j in 0..n {
+            let u = (i as f64 + 0.5) / n as f64;
+            // Offset rows so the pattern has no radial alignment.
+            let w = (j as f64 + 0.5 + 0.5 * (i % 2) as f64) / n as f64;
+            let cos_t = 1.0 - u * (1.0 - cos_max);
+            let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
+            let psi = 2.0 * PI * w;
+            out.push((d * cos_t + (e1 * psi.cos() + e2 * psi.sin()) * sin_t).normalize());
+        }
+    }
+    out
+}
+
+/// The sample directions (θ, φ in degrees) for `spec`: coarse rings over
+/// the front hemisphere, a dense polar patch around the mirror direction,
+/// and for transmitting truths the same mirrored to the back.
+fn layout_directions(spec: &SynthSpec) -> Vec<(f64, f64)> {
+    let layout = &spec.layout;
+    let mut dirs = Vec::new();
+    let mut ring = |theta: f64, step: f64, back: bool| {
+        let n = ((360.0 * theta.to_radians().sin() / step).round() as usize).max(1);
+        for k in 0..n {
+            let phi = 360.0 * k as f64 / n as f64;
+            dirs.push((if back { 180.0 - theta } else { theta }, phi));
+        }
+    };
+    let rings = (layout.max_theta_deg / layout.coarse_step_deg).floor() as usize;
+    let back = spec.truth.transmits();
+    for i in 0..=rings {
+        let theta = i as f64 * layout.coarse_step_deg;
+        ring(theta, layout.coarse_step_deg, false);
+        if back {
+            ring(theta, layout.coarse_step_deg, true);
+        }
+    }
+    // Dense patch: concentric rings around the peak out to 3 lobe widths.
+    let mirror = spec.incidence.mirror_direction();
+    let radius = (3.0 * spec.truth.lobe_width())
+        .to_degrees()
+        .clamp(2.0, 20.0);
+    let (e1, e2) = frame(mirror);
+    let steps = (radius / layout.fine_step_deg).ceil() as usize;
+    for i in 1..=steps {
+        let delta = (i as f64 * layout.fine_step_deg).to_radians();
+        let n =
+            ((2.0 * PI * delta.sin() / layout.fine_step_deg.to_radians()).round() as usize).max(6);
+        for k in 0..n {
+            let psi = 2.0 * PI * k as f64 / n as f64;
+            let d = mirror * delta.cos() + (e1 * psi.cos() + e2 * psi.sin()) * delta.sin();
+            for candidate in
+                [d, DVec3::new(d.x, d.y, -d.z)]
+                    .into_iter()
+                    .take(if back { 2 } else { 1 })
+            {
+                let theta = candidate.z.clamp(-1.0, 1.0).acos().to_degrees();
+                let front_theta = theta.min(180.0 - theta);
+                if front_theta <= layout.max_theta_deg {
+                    let phi = candidate
+                        .y
+                        .atan2(candidate.x)
+                        .to_degrees()
+                        .rem_euclid(360.0);
+                    dirs.push((theta, if phi >= 360.0 { 0.0 } else { phi }));
+                }
+            }
+        }
+    }
+    dirs.push((spec.incidence.mirror_theta(), spec.incidence.mirror_phi()));
+    dirs
+}
+
+impl Incidence {
+    fn mirror_theta(&self) -> f64 {
+        self.theta_deg
+    }
+
+    fn mirror_phi(&self) -> f64 {
+        (self.phi_deg + 180.0).rem_euclid(360.0)
+    }
+}
+
+/// A synthetic measurement of `spec` (BSDF, with file-style solid angles).
+pub fn synthesize(spec: &SynthSpec) -> Measurement {
+    let mut rng = Rng(spec.seed ^ 0xB5F0_2A11_u64);
+    let instrument = &spec.instrument;
+    let light = spec.incidence.direction();
+    let lights = cone_directions(
+        light,
+        instrument.source_aperture_deg,
+        instrument.aperture_rays,
+    );
+    let blind_cos = instrument.blind_spot_deg.to_radians().cos();
+    let gap_phi = (spec.incidence.phi_deg + 90.0).rem_euclid(360.0);
+    let mut samples = Vec::new();
+    for (theta, phi) in layout_directions(spec) {
+        let v = direction(theta, phi);
+        if instrument.blind_spot_deg > 0.0 && v.dot(light) > blind_cos {
+            continue;
+        }
+        let front_theta = theta.min(180.0 - theta);
+        let dphi = ((phi - gap_phi + 540.0).rem_euclid(360.0) - 180.0).abs();
+        if instrument.holder_gap && front_theta > 80.0 && dphi < 10.0 {
+            continue;
+        }
+        let views = cone_directions(
+            v,
+            instrument.detector_aperture_deg,
+            instrument.aperture_rays,
+        );
+        let mut mean = [0.0; 3];
+        for l in &lights {
+            for d in &views {
+                let f = spec.truth.eval(*l, *d);
+                for c in 0..3 {
+                    mean[c] += f[c];
+                }
+            }
+        }
+        let n = (lights.len() * views.len()) as f64;
+        let noisy = |value: f64, rng: &mut Rng| {
+            value * (1.0 + instrument.noise_relative * rng.normal())
+                + instrument.noise_floor * rng.normal()
+        };
+        let values = match spec.channels {
+            Channels::Y => [
+                noisy((mean[0] + mean[1] + mean[2]) / (3.0 * n), &mut rng),
+                0.0,
+                0.0,
+            ],
+            Channels::Xyz => {
+                let k = 1.0 + instrument.noise_relative * rng.normal();
+                let floor = [rng.normal(), rng.normal(), rng.normal()];
+                [0, 1, 2].map(|c| mean[c] / n * k + instrument.noise_floor * floor[c])
+            }
+        };
+        samples.push(Sample::new(theta, phi, values));
+    }
+    if instrument.back_rows && !spec.truth.transmits() {
+        // Opaque sample: the back detector sees only its own noise.
+        let step = 2.0 * spec.layout.coarse_step_deg;
+        let rings = (spec.layout.max_theta_deg / step).floor() as usize;
+        for i in 0..=rings {
+            let theta = 180.0 - i as f64 * step;
+            let count =
+                ((360.0 * (i as f64 * step).to_radians().sin() / step).round() as usize).max(1);
+            for k in 0..count {
+                let phi = 360.0 * k as f64 / count as f64;
+                let noise = |rng: &mut Rng| instrument.noise_floor * rng.normal();
+                let values = match spec.channels {
+                    Channels::Y => [noise(&mut rng), 0.0, 0.0],
+                    Channels::Xyz => [noise(&mut rng), noise(&mut rng), noise(&mut rng)],
+                };
+                samples.push(Sample::new(theta, phi, values));
+            }
+        }
+    }
+    let weights = compute_solid_angles(&samples);
+    for (s, w) in samples.iter_mut().zip(weights) {
+        s.solid_angle_sr = Some(w);
+    }
+    let mut m = Measurement::new(
+        SourceFormat::Mpc,
+        spec.incidence,
+        Quantity::Bsdf,
+        spec.channels,
+        samples,
+    );
+    m.incidence_origin = IncidenceOrigin::Programmatic;
+    m.sample_name = Some(spec.sample_name.clone());
+    m
+}
