@@ -643,7 +643,7 @@ fn make_block(d: &IncidenceData, _global: bool) -> Block {
 /// Every k-th sample, keeping the block's weight total.
 fn subsample(b: &Block, target: usize) -> Block {
     let step = (b.len() / target.max(1)).max(1);
-    let pick = |i: &usize| i % step == 0;
+    let pick = |i: &usize| i.is_multiple_of(step);
     let idx: Vec<usize> = (0..b.len()).filter(pick).collect();
     let w = (step as f64).sqrt();
     Block {
@@ -784,16 +784,14 @@ fn starting_points(
             .filter(|s| s.view.z > 0.0)
             .collect();
         for s in &front {
-            for c in 0..channels {
-                m[c] += s.value[c];
+            for (acc, v) in m.iter_mut().zip(&s.value[..channels]) {
+                *acc += v;
             }
         }
         let total: f64 = m[..channels].iter().sum::<f64>().max(1e-300);
         let mut ratio = [1.0; 3];
         if channels == 3 {
-            for c in 0..3 {
-                ratio[c] = 3.0 * m[c] / total;
-            }
+            ratio = m.map(|mc| 3.0 * mc / total);
         }
         ratio
     };

@@ -20,6 +20,7 @@ use std::f64::consts::PI;
 
 /// What the synthetic sample really is.
 #[derive(Debug, Clone, Copy)]
+#[allow(clippy::large_enum_variant)] // built once per file, never stored in bulk
 pub enum GroundTruth {
     /// A brtf-model material, evaluated with its options.
     Model(Bsdf),
