@@ -11,4 +11,5 @@
 mod albedo;
 mod common;
 mod eval;
+mod fit;
 mod rtrace;

@@ -1,0 +1,354 @@
+//! `brtf synth` + `brtf fit` end to end: parameter recovery from synthetic
+//! files, model mismatch on the shipped GGX set, the real pgII scans, and
+//! bad input.
+
+use crate::common::{brtf, repo_path, s, temp_dir, write_file};
+use brtf_fit::FitResult;
+use std::path::{Path, PathBuf};
+
+const THETAS: &str = "0,15,30,45,60";
+
+/// Writes synthetic files of `material` (Radiance text) into `dir/set`.
+fn synth(dir: &Path, material: &str, extra: &[&str]) -> Vec<PathBuf> {
+    let rad = write_file(dir, "truth.rad", material);
+    let out = dir.join("set");
+    let mut args = vec![
+        "synth",
+        "--material",
+        s(&rad),
+        "--theta-in",
+        THETAS,
+        "--out",
+        s(&out),
+    ];
+    args.extend_from_slice(extra);
+    brtf(&args, "").ok();
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    files.sort();
+    assert_eq!(files.len(), 5, "{files:?}");
+    files
+}
+
+fn fit(dir: &Path, files: &[PathBuf], extra: &[&str]) -> FitResult {
+    let out = dir.join("fit");
+    let mut args: Vec<String> = vec!["fit".into()];
+    args.extend(files.iter().map(|f| s(f).to_string()));
+    args.extend(["--out".into(), s(&out).into()]);
+    args.extend(extra.iter().map(|a| a.to_string()));
+    brtf(&args, "").ok();
+    let text = std::fs::read_to_string(out.join("fit.json")).unwrap();
+    serde_json::from_str(&text).unwrap()
+}
+
+/// No noise, point apertures: the exact parameters, to 1e-6.
+const EXACT: &[&str] = &[
+    "--noise",
+    "0",
+    "--noise-floor",
+    "0",
+    "--source-aperture",
+    "0",
+    "--detector-aperture",
+    "0",
+];
+
+fn assert_exact(result: &FitResult, truth: &[f64]) {
+    assert_eq!(result.incidences.len(), 5);
+    for r in result.incidences.iter().chain(result.global.iter()) {
+        assert!(
+            r.termination.converged(),
+            "θ={} {:?}",
+            r.theta_in,
+            r.termination
+        );
+        for (got, want) in r.material_args.iter().zip(truth) {
+            assert!(
+                (got - want).abs() <= 1e-6,
+                "θ={}: {:?} vs {truth:?}",
+                r.theta_in,
+                r.material_args
+            );
+        }
+    }
+}
+
+#[test]
+fn recovers_exact_parameters_without_noise() {
+    let cases: [(&str, &str, &[f64], &[&str], &[&str]); 5] = [
+        (
+            "metal",
+            "void metal m 0 0 5 0.8 0.8 0.8 0.9 0.06",
+            &[0.8, 0.8, 0.8, 0.9, 0.06],
+            &[],
+            &["--gray"],
+        ),
+        (
+            "metal",
+            "void metal m 0 0 5 0.95 0.64 0.54 0.85 0.1",
+            &[0.95, 0.64, 0.54, 0.85, 0.1],
+            &["--format", "mountain", "--channels", "3"],
+            &[],
+        ),
+        (
+            "plastic",
+            "void plastic p 0 0 5 0.4 0.4 0.4 0.05 0.08",
+            &[0.4, 0.4, 0.4, 0.05, 0.08],
+            &[],
+            &[],
+        ),
+        (
+            "trans",
+            "void trans t 0 0 7 0.7 0.7 0.7 0.05 0.1 0.5 0.6",
+            &[0.7, 0.7, 0.7, 0.05, 0.1, 0.5, 0.6],
+            &[],
+            &[],
+        ),
+        (
+            "metal2",
+            "void metal2 b 4 1 0 0 . 0 6 0.9 0.9 0.9 0.85 0.04 0.15",
+            &[0.9, 0.9, 0.9, 0.85, 0.04, 0.15],
+            &[],
+            &[],
+        ),
+    ];
+    for (model, material, truth, synth_args, fit_args) in cases {
+        let dir = temp_dir();
+        let mut args = EXACT.to_vec();
+        args.extend_from_slice(synth_args);
+        let files = synth(dir.path(), material, &args);
+        let mut fargs = vec!["--model", model, "--no-export", "--no-plots"];
+        fargs.extend_from_slice(fit_args);
+        let result = fit(dir.path(), &files, &fargs);
+        assert_exact(&result, truth);
+    }
+}
+
+#[test]
+fn recovers_parameters_within_three_standard_errors_at_two_percent_noise() {
+    let cases: [(&str, &str, &[f64], &[&str]); 3] = [
+        (
+            "metal",
+            "void metal m 0 0 5 0.9 0.9 0.9 0.85 0.07",
+            &[0.9, 0.9, 0.9, 0.85, 0.07],
+            &[],
+        ),
+        (
+            "metal",
+            "void metal m 0 0 5 0.95 0.64 0.54 0.85 0.1",
+            &[0.95, 0.64, 0.54, 0.85, 0.1],
+            &["--format", "mountain", "--channels", "3"],
+        ),
+        (
+            "metal2",
+            "void metal2 b 4 1 0 0 . 0 6 0.9 0.9 0.9 0.85 0.05 0.15",
+            &[0.9, 0.9, 0.9, 0.85, 0.05, 0.15],
+            &[],
+        ),
+    ];
+    for (model, material, truth, synth_args) in cases {
+        let dir = temp_dir();
+        // 2 % noise, noise floor, blind spot, holder gap, noisy back rows;
+        // point apertures (finite ones widen the lobe: see docs/fitting.md).
+        let mut args = vec![
+            "--noise",
+            "0.02",
+            "--noise-floor",
+            "1e-4",
+            "--source-aperture",
+            "0",
+            "--detector-aperture",
+            "0",
+        ];
+        args.extend_from_slice(synth_args);
+        let files = synth(dir.path(), material, &args);
+        let result = fit(
+            dir.path(),
+            &files,
+            &[
+                "--model",
+                model,
+                "--residual",
+                "relative",
+                "--no-export",
+                "--no-plots",
+            ],
+        );
+        for r in &result.incidences {
+            for (p, want) in r.params.iter().zip(truth.iter()) {
+                assert!(
+                    (p.value - want).abs() <= 3.0 * p.stderr,
+                    "{material} θ={} {}: {} ± {} vs {want}",
+                    r.theta_in,
+                    p.name,
+                    p.value,
+                    p.stderr
+                );
+                if p.name == "spec" || p.name.starts_with("rough") {
+                    let rel = (p.value - want).abs() / want;
+                    assert!(
+                        rel < 0.02,
+                        "{material} θ={} {} off by {rel}",
+                        r.theta_in,
+                        p.name
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn ggx_set_converges_everywhere_with_no_parameter_at_a_bound() {
+    let dir = temp_dir();
+    let files: Vec<PathBuf> = ["0", "15", "30", "45", "60"]
+        .iter()
+        .map(|t| repo_path(&format!("data/alu-ggx/alu-ggx:+{t}+0.mpc")))
+        .collect();
+    let result = fit(
+        dir.path(),
+        &files,
+        &["--model", "metal", "--no-export", "--no-plots"],
+    );
+    for r in result.incidences.iter().chain(result.global.iter()) {
+        assert!(
+            r.termination.converged(),
+            "θ={} {:?}",
+            r.theta_in,
+            r.termination
+        );
+        assert!(
+            r.params.iter().all(|p| !p.at_bound),
+            "θ={} {:?}",
+            r.theta_in,
+            r.params
+        );
+        // The mismatch shows: a Gaussian cannot follow GGX tails.
+        assert!(r.rms_rel > 0.05, "θ={} rms_rel {}", r.theta_in, r.rms_rel);
+    }
+    let table = result.table.expect("five incidences give a table");
+    assert_eq!(table.theta_in, vec![0.0, 15.0, 30.0, 45.0, 60.0]);
+    let csv = std::fs::read_to_string(dir.path().join("fit/params.csv")).unwrap();
+    assert!(csv.starts_with("theta_in,phi_in,n_points,red,green,blue,spec,rough,red_stderr"));
+    assert_eq!(csv.lines().count(), 7, "header, 5 incidences, all");
+}
+
+fn real_scan(name: &str) -> PathBuf {
+    let path = repo_path("../shared/data/rgl-epfl-pgII-raw").join(name);
+    assert!(
+        path.exists(),
+        "{} is missing: CI always has ../shared/data",
+        path.display()
+    );
+    path
+}
+
+#[test]
+fn real_pgii_scans_fit_with_a_free_scale() {
+    for (file, model) in [
+        ("golden_paper.txt", "metal"),
+        ("layer_020_030.txt", "plastic"),
+    ] {
+        let dir = temp_dir();
+        let result = fit(
+            dir.path(),
+            &[real_scan(file)],
+            &["--model", model, "--no-export", "--no-plots"],
+        );
+        let r = &result.incidences[0];
+        assert!(r.termination.converged(), "{file}: {:?}", r.termination);
+        assert!(
+            r.params
+                .iter()
+                .all(|p| p.value.is_finite() && p.stderr.is_finite())
+        );
+        let spec = r.value("spec").unwrap();
+        let rough = r.value("rough").unwrap();
+        assert!(spec > 0.0 && spec <= 1.0, "{file}: spec {spec}");
+        assert!(rough > 0.01 && rough < 0.5, "{file}: rough {rough}");
+        assert!(r.value("scale").unwrap() > 0.0);
+        assert!(result.provenance.inputs[0].quantity.contains("free scale"));
+        eprintln!(
+            "{file} as {model}: spec {spec:.4} rough {rough:.4} scale {:.5} rms_rel {:.3}",
+            r.scale, r.rms_rel
+        );
+    }
+}
+
+#[test]
+fn bad_input_is_a_clear_error_and_writes_nothing() {
+    let dir = temp_dir();
+    let files = synth(dir.path(), "void metal m 0 0 5 0.8 0.8 0.8 0.9 0.06", &[]);
+    let out = dir.path().join("out");
+    // Every sample removed by the gates.
+    let err = brtf(
+        &[
+            "fit",
+            s(&files[2]),
+            "--model",
+            "metal",
+            "--min-value",
+            "1e9",
+            "--out",
+            s(&out),
+        ],
+        "",
+    )
+    .err();
+    assert!(
+        err.contains("no samples left") && err.contains("value >= 1000000000 removed"),
+        "{err}"
+    );
+    assert!(!out.join("fit.json").exists() && !out.join("params.csv").exists());
+    // All-zero data.
+    let zeros = write_file(
+        dir.path(),
+        "zeros.txt",
+        "#intheta 30\n#inphi 0\n#format: theta phi BSDF\n10 0 0\n20 90 0\n30 180 0\n40 270 0\n",
+    );
+    let err = brtf(
+        &[
+            "fit",
+            s(&zeros),
+            "--model",
+            "metal",
+            "--beam-mask",
+            "0",
+            "--out",
+            s(&out),
+        ],
+        "",
+    )
+    .err();
+    assert!(err.contains("zero or negative"), "{err}");
+    // NaN in a file: the reader names the line.
+    let nan = write_file(
+        dir.path(),
+        "nan.txt",
+        "#intheta 30\n#inphi 0\n#format: theta phi BSDF\n10 0 0.3\n20 90 nan\n",
+    );
+    let err = brtf(&["fit", s(&nan), "--model", "metal", "--out", s(&out)], "").err();
+    assert!(err.contains("nan.txt:5"), "{err}");
+    assert!(!out.exists(), "a failed fit left {}", out.display());
+    // One incidence cannot be interpolated: a warning, and no table.
+    let run = brtf(
+        &[
+            "fit",
+            s(&files[1]),
+            "--model",
+            "metal",
+            "--out",
+            s(&out),
+            "--no-export",
+            "--no-plots",
+        ],
+        "",
+    );
+    assert!(run.success, "{run}");
+    assert!(run.stderr.contains("at least two incidences"), "{run}");
+    let result: FitResult =
+        serde_json::from_str(&std::fs::read_to_string(out.join("fit.json")).unwrap()).unwrap();
+    assert!(result.table.is_none());
+}
