@@ -81,6 +81,10 @@ pub struct FitArgs {
     /// Beam integral for raw-signal files (makes the fit absolute); overrides the file's.
     #[arg(long)]
     pub beam_integral: Option<f64>,
+    /// A known directional-hemispherical reflectance `VALUE@THETA` (e.g.
+    /// `0.85@30`) that makes a raw-signal fit absolute.
+    #[arg(long, value_parser = parse_rho)]
+    pub rho: Option<(f64, f64)>,
     /// Fit a free overall scale even when the data are absolute.
     #[arg(long)]
     pub free_scale: bool,
@@ -140,6 +144,20 @@ fn parse_fresnel_k(s: &str) -> Result<f64, String> {
             .parse()
             .map_err(|_| format!("expected classic, pyradiance or a number, found `{other}`")),
     }
+}
+
+fn parse_rho(s: &str) -> Result<(f64, f64), String> {
+    let (value, theta) = s
+        .split_once('@')
+        .ok_or("expected VALUE@THETA, e.g. 0.85@30")?;
+    let value: f64 = value
+        .parse()
+        .map_err(|_| format!("bad reflectance `{value}`"))?;
+    let theta: f64 = theta.parse().map_err(|_| format!("bad angle `{theta}`"))?;
+    if !(value > 0.0 && value <= 1.0 && (0.0..90.0).contains(&theta)) {
+        return Err("need 0 < VALUE ≤ 1 and 0 ≤ THETA < 90".into());
+    }
+    Ok((value, theta))
 }
 
 fn parse_loss(s: &str) -> Result<RobustLoss, String> {
@@ -208,7 +226,7 @@ pub fn run(args: FitArgs) -> Result<()> {
         bail!("the files mix absolute and raw-signal data; give --beam-integral or --free-scale");
     }
 
-    let config = FitConfig {
+    let mut config = FitConfig {
         kind: args.model,
         options: brtf_model::EvalOptions {
             variant: args.variant,
@@ -237,35 +255,58 @@ pub fn run(args: FitArgs) -> Result<()> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.jobs.unwrap_or(0))
         .build()?;
-    let bar = ProgressBar::new(prepared.len() as u64 + 1);
-    bar.set_style(
-        ProgressStyle::with_template("{spinner} fitting {pos}/{len} [{bar:30}] {elapsed} {msg}")
-            .expect("valid template")
-            .progress_chars("=> "),
-    );
-    let (reports, global) = pool.install(|| {
-        rayon::join(
-            || {
-                prepared
-                    .par_iter()
-                    .map(|p| {
-                        let r = fit_incidence(&p.data, &config);
-                        bar.inc(1);
-                        r
-                    })
-                    .collect::<Vec<_>>()
-            },
-            || {
-                let data: Vec<IncidenceData> = prepared.iter().map(|p| p.data.clone()).collect();
-                let r = fit_global(&data, &config);
-                bar.inc(1);
-                r
-            },
-        )
-    });
-    bar.finish_and_clear();
-    let reports: Vec<FitReport> = reports.into_iter().collect::<Result<_, _>>()?;
-    let global = global?;
+    let (mut reports, mut global) = pool.install(|| fit_all(&prepared, &config))?;
+
+    // A known reflectance turns a free-scale fit absolute: the fitted model's
+    // ρ_dh at that incidence fixes the instrument's scale K; the data are
+    // divided by K and fitted again without a free scale.
+    if let Some((rho, theta)) = args.rho {
+        if !config.free_scale {
+            bail!("--rho is for raw-signal data fitted with a free scale; these data are absolute");
+        }
+        let nearest = reports
+            .iter()
+            .min_by(|a, b| {
+                (a.theta_in - theta)
+                    .abs()
+                    .total_cmp(&(b.theta_in - theta).abs())
+            })
+            .expect("at least one incidence");
+        if (nearest.theta_in - theta).abs() > 5.0 {
+            eprintln!(
+                "brtf: warning: --rho given at θ_in {theta}°, nearest fitted incidence is {}°",
+                nearest.theta_in
+            );
+        }
+        let material = brtf_model::Material::new(
+            config.kind,
+            &nearest.material_args,
+            Some(glam::DVec3::from_array(config.orientation)),
+        )?;
+        let bsdf = brtf_model::Bsdf::new(&material, &config.options);
+        let albedo = brtf_model::albedo(&bsdf, brtf_model::direction(theta, nearest.phi_in), 1e-6);
+        let model_rho = nearest.scale * (albedo.rho.iter().sum::<f64>() / 3.0);
+        let k = model_rho / rho;
+        anyhow::ensure!(
+            k.is_finite() && k > 0.0,
+            "--rho: the fitted model has no reflectance at {theta}°"
+        );
+        eprintln!(
+            "brtf: --rho {rho}@{theta}: instrument scale K = {k:.6e} (data ÷ K are absolute BSDF)"
+        );
+        for p in &mut prepared {
+            for sample in &mut p.data.samples {
+                sample.value = sample.value.map(|v| v / k);
+            }
+            let base = p
+                .input
+                .quantity
+                .replace(", free scale (no beam integral)", "");
+            p.input.quantity = format!("{base} ÷ K = {k:.6e} from --rho {rho}@{theta}");
+        }
+        config.free_scale = false;
+        (reports, global) = pool.install(|| fit_all(&prepared, &config))?;
+    }
     let interpolation = match args.interpolation {
         InterpArg::Pchip => Interpolation::Pchip,
         InterpArg::Linear => Interpolation::Linear,
@@ -297,6 +338,49 @@ pub fn run(args: FitArgs) -> Result<()> {
     write_outputs(&out, &result)?;
     print!("{}", summary(&result, &out));
     Ok(())
+}
+
+/// Fits every incidence and all of them at once, in parallel, with a
+/// progress bar.
+fn fit_all(prepared: &[Prepared], config: &FitConfig) -> Result<(Vec<FitReport>, FitReport)> {
+    let bar = ProgressBar::new(prepared.len() as u64 + 1);
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} fitting {pos}/{len} [{bar:30}] {elapsed} {msg}")
+            .expect("valid template")
+            .progress_chars("=> "),
+    );
+    let (reports, global) = rayon::join(
+        || {
+            prepared
+                .par_iter()
+                .map(|p| {
+                    let r = fit_incidence(&p.data, config);
+                    bar.inc(1);
+                    r
+                })
+                .collect::<Vec<_>>()
+        },
+        || {
+            // With one incidence the all-incidence fit is that fit.
+            if prepared.len() < 2 {
+                return None;
+            }
+            let data: Vec<IncidenceData> = prepared.iter().map(|p| p.data.clone()).collect();
+            let r = fit_global(&data, config);
+            bar.inc(1);
+            Some(r)
+        },
+    );
+    bar.finish_and_clear();
+    let reports = reports.into_iter().collect::<Result<Vec<_>, _>>()?;
+    let global = match global {
+        Some(g) => g?,
+        None => FitReport {
+            source: "all incidences".into(),
+            ..reports[0].clone()
+        },
+    };
+    Ok((reports, global))
 }
 
 /// The files' common folder name, else `fit`.
@@ -539,7 +623,8 @@ fn summary(result: &FitResult, out: &Path) -> String {
     }
     let _ = writeln!(s, "(! = at a bound, = = held fixed)");
     let mut warned = false;
-    for r in result.incidences.iter().chain(result.global.iter()) {
+    let global = result.global.iter().filter(|_| result.incidences.len() > 1);
+    for r in result.incidences.iter().chain(global) {
         for w in &r.warnings {
             if !warned {
                 let _ = writeln!(s, "\nwarnings:");

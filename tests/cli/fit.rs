@@ -278,6 +278,67 @@ fn real_pgii_scans_fit_with_a_free_scale() {
 }
 
 #[test]
+fn a_known_reflectance_makes_a_raw_fit_absolute() {
+    let dir = temp_dir();
+    let result = fit(
+        dir.path(),
+        &[real_scan("golden_paper.txt")],
+        &[
+            "--model",
+            "metal",
+            "--rho",
+            "0.8@26.8421",
+            "--no-export",
+            "--no-plots",
+        ],
+    );
+    let r = &result.incidences[0];
+    assert!(
+        r.params.iter().all(|p| p.name != "scale"),
+        "no free scale after --rho"
+    );
+    assert!(
+        result.provenance.inputs[0]
+            .quantity
+            .contains("from --rho 0.8@26.8421")
+    );
+    // The fitted material's own ρ_dh at that incidence is the given 0.8.
+    let material = write_file(
+        dir.path(),
+        "m.rad",
+        &format!(
+            "void metal m 0 0 5 {}",
+            r.material_args
+                .iter()
+                .map(|a| a.to_string())
+                .collect::<Vec<_>>()
+                .join(" ")
+        ),
+    );
+    let out = brtf(
+        &[
+            "albedo",
+            "--material",
+            s(&material),
+            "--theta-in",
+            "26.8421",
+        ],
+        "",
+    )
+    .ok();
+    let rho: f64 = out
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .nth(2)
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!((rho - 0.8).abs() < 2e-3, "ρ_dh {rho}");
+}
+
+#[test]
 fn bad_input_is_a_clear_error_and_writes_nothing() {
     let dir = temp_dir();
     let files = synth(dir.path(), "void metal m 0 0 5 0.8 0.8 0.8 0.9 0.06", &[]);
