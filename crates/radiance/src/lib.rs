@@ -4,7 +4,12 @@
 //! the string, integer and real argument lists), and converts the six
 //! Ward-type material primitives to and from [`brtf_model::Material`].
 //! Errors carry the file and line: `file:line: message`.
+//!
+//! [`export`] writes a fit's Radiance materials: the static primitive, the
+//! θ_in-dependent function material with its `.cal` file, and a preview
+//! scene (`docs/radiance.md`).
 
+pub mod export;
 mod primitive;
 
 pub use primitive::{

@@ -1,0 +1,454 @@
+//! The `.cal` file of the θ_in-dependent material.
+//!
+//! It holds two things, both generated from the fit:
+//!
+//! 1. **The parameter table.** Every real argument as a function of θ_in
+//!    (degrees): brtf-fit's interpolation written as explicit cubic
+//!    segments ([`Pieces`]), clamped to the measured range.
+//! 2. **The BSDF.** brtf-model's formulas for the fitted type and variant,
+//!    in Radiance's function language, evaluated with the parameters at
+//!    the θ_in of the light: `θ_in = acos |l·n|`, where `l` is the
+//!    direction to the light source sample and `n` the surface normal.
+//!
+//! Radiance calls the entry functions with the direction to the light
+//! `(lx, ly, lz)` and the source's solid angle `om`; `Dx, Dy, Dz` (the ray
+//! direction), `NxP, NyP, NzP` (the normal, turned towards the viewer) and
+//! `RdotP` (the view cosine) describe the current ray. Each function file
+//! is read in its own context (named after the file), so the names here
+//! cannot clash with another exported material's.
+//!
+//! Two kinds of entry point:
+//!
+//! * [`Entry::Brtd`] for `BRTDfunc`: per channel the whole BSDF minus the
+//!   constant diffuse parts that the material's real arguments carry
+//!   (those also receive indirect light), plus the mirror and
+//!   straight-through coefficients of roughness-0 rows.
+//! * [`Entry::Lobe`] for `plasfunc`/`metfunc`/`transfunc`: only the
+//!   specular lobes, when colour, specularity and transmission do not
+//!   change with θ_in and Radiance's constant arguments can carry them.
+
+use super::num::num;
+use super::pieces::Pieces;
+use brtf_model::{MaterialKind, Variant};
+use std::fmt::Write;
+
+/// Channel function names of the `BRTDfunc` entry.
+pub(crate) const CHANNEL_FUNCTIONS: [&str; 3] = ["f_red", "f_green", "f_blue"];
+/// Mirror (ideal specular reflection) coefficients of roughness-0 rows.
+pub(crate) const MIRROR_VARIABLES: [&str; 3] = ["m_red", "m_green", "m_blue"];
+/// Straight-through (ideal specular transmission) coefficients.
+pub(crate) const THROUGH_VARIABLES: [&str; 3] = ["t_red", "t_green", "t_blue"];
+/// The lobe function of the `plasfunc`/`metfunc`/`transfunc` entry.
+pub(crate) const LOBE_FUNCTION: &str = "f_lobe";
+
+/// Which Radiance material calls the file.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Entry {
+    /// `BRTDfunc`: the functions return the BSDF minus `rd0/π` (light in
+    /// front) or `td0/π` (light behind), per channel.
+    Brtd {
+        /// Constant diffuse reflectance in the material's arguments.
+        rd0: [f64; 3],
+        /// Constant diffuse transmittance in the material's arguments.
+        td0: [f64; 3],
+        /// Emit the roughness-0 mirror and straight-through coefficients.
+        deltas: bool,
+    },
+    /// `plasfunc`/`metfunc`/`transfunc`: the specular lobes only.
+    Lobe,
+}
+
+/// Everything the `.cal` text depends on.
+#[derive(Debug, Clone)]
+pub(crate) struct CalModel<'a> {
+    pub kind: MaterialKind,
+    pub variant: Variant,
+    /// `K` of the roughness-0 Fresnel estimate (radiance variant).
+    pub fresnel_k: f64,
+    /// Orientation vector of the `*2` types (function coordinates).
+    pub orientation: [f64; 3],
+    pub pieces: &'a Pieces,
+    pub entry: Entry,
+}
+
+impl CalModel<'_> {
+    /// True when the three colour channels give the same function, so the
+    /// material can name one function three times (Radiance then
+    /// evaluates it once).
+    pub fn grey(&self) -> bool {
+        let s = &self.pieces.segments;
+        let same = s[0] == s[1] && s[1] == s[2];
+        match self.entry {
+            Entry::Brtd { rd0, td0, .. } => {
+                same && rd0.iter().all(|&x| x == rd0[0]) && td0.iter().all(|&x| x == td0[0])
+            }
+            Entry::Lobe => same,
+        }
+    }
+
+    /// The `.cal` text. `header` lines become a leading comment.
+    pub fn text(&self, header: &[String]) -> String {
+        let mut o = String::new();
+        o += "{\n";
+        for line in header {
+            // Braces would end the comment early.
+            let line = line.replace(['{', '}'], "");
+            o += &format!("  {line}\n").replace("  \n", "\n");
+        }
+        o += "}\n\n";
+        self.parameters(&mut o);
+        self.constants(&mut o);
+        self.geometry(&mut o);
+        match self.entry {
+            Entry::Brtd { .. } => self.coefficients(&mut o),
+            Entry::Lobe => {}
+        }
+        self.lobes(&mut o);
+        match self.entry {
+            Entry::Brtd { rd0, td0, deltas } => self.brtd_entry(&mut o, rd0, td0, deltas),
+            Entry::Lobe => self.lobe_entry(&mut o),
+        }
+        o
+    }
+
+    fn iso(&self) -> bool {
+        !self.kind.is_anisotropic()
+    }
+
+    fn transmitting(&self) -> bool {
+        self.kind.is_transmitting()
+    }
+
+    /// Section 1: the parameter functions `p_<name>(t)`.
+    fn parameters(&self, o: &mut String) {
+        let nodes = &self.pieces.nodes;
+        let (lo, hi) = (nodes[0], nodes[nodes.len() - 1]);
+        let list: Vec<String> = nodes.iter().map(|&x| num(x)).collect();
+        *o += "{ ===== 1. The fitted parameters as functions of theta_in (degrees) =====\n";
+        *o += &format!("  Measured incidences: {}.\n", list.join(" "));
+        *o += "  Each segment is a cubic in s = theta_in - (segment start), exactly\n";
+        *o += "  brtf-fit's interpolation; outside the measured range the end values hold. }\n";
+        let _ = writeln!(o, "t_lo : {};", num(lo));
+        let _ = writeln!(o, "t_hi : {};", num(hi));
+        *o += "t_clamp(t) : if(t - t_hi, t_hi, if(t_lo - t, t_lo, t));\n";
+        *o += "cubic(s, a0, a1, a2, a3) : a0 + s*(a1 + s*(a2 + s*a3));\n";
+        let names = self.kind.param_names();
+        for (p, name) in names.iter().enumerate() {
+            let segs = &self.pieces.segments[p];
+            *o += "\n";
+            if let Some(q) = (0..p).find(|&q| self.pieces.segments[q] == *segs) {
+                let _ = writeln!(o, "p_{name}(t) : p_{}(t);", names[q]);
+                continue;
+            }
+            let _ = writeln!(o, "p_{name}(t) : p_{name}_0(t_clamp(t));");
+            let last = segs.len() - 1;
+            for (i, seg) in segs.iter().enumerate() {
+                let c = seg.coef;
+                let cubic = format!(
+                    "cubic(t - {}, {}, {}, {}, {})",
+                    num(seg.start),
+                    num(c[0]),
+                    num(c[1]),
+                    num(c[2]),
+                    num(c[3])
+                );
+                if i < last {
+                    let _ = writeln!(
+                        o,
+                        "p_{name}_{i}(t) : if(t - {}, p_{name}_{}(t), {cubic});",
+                        num(nodes[i + 1]),
+                        i + 1
+                    );
+                } else {
+                    let _ = writeln!(o, "p_{name}_{i}(t) : {cubic};");
+                }
+            }
+        }
+        *o += "\ncol(k, t) : select(k, p_red(t), p_green(t), p_blue(t));\n\n";
+    }
+
+    /// Section 2: constants and helpers.
+    fn constants(&self, o: &mut String) {
+        *o += "{ ===== 2. Constants and helpers ===== }\n";
+        *o += "ftiny : 1e-6;                            { rtrace's FTINY }\n";
+        *o += "cutoff(x) : if(x - ftiny, x, 0);         { rtrace drops lobe values <= 1e-6 }\n";
+        *o += "ex(x) : if(x - 600, 0, exp(-x));          { exp(-x) without underflow }\n";
+        if self.variant == Variant::Radiance && self.iso() {
+            let _ = writeln!(
+                o,
+                "fresnel_k : {};\nfres(c) : exp(-5.85*c) - fresnel_k;     {{ roughness-0 Fresnel estimate }}",
+                num(self.fresnel_k)
+            );
+        }
+        *o += "\n";
+    }
+
+    /// Section 3: the current ray and, for the `*2` types, the tangent frame.
+    fn geometry(&self, o: &mut String) {
+        *o += "{ ===== 3. Geometry: the current ray and the light =====\n";
+        *o += "  NxP NyP NzP is the normal turned towards the viewer, RdotP the view cosine. }\n";
+        *o += "cosv = max(RdotP, .001);                 { view cosine, clamped as rtrace does }\n";
+        *o += "vx = -Dx; vy = -Dy; vz = -Dz;            { towards the viewer }\n";
+        *o +=
+            "cosl(lx, ly, lz) = lx*NxP + ly*NyP + lz*NzP;   { light cosine, < 0: light behind }\n";
+        *o += "thin(c) : acos(min(1, abs(c)))/DEGREE;   { theta_in of the light, degrees }\n";
+        if self.variant == Variant::Ward1992 {
+            *o += "e6 = exp(-6*cosv);                       { Ward 1992 Fresnel estimate }\n";
+        }
+        if !self.iso() {
+            let [x, y, z] = self.orientation;
+            *o +=
+                "{ Tangent frame: v_hat = normalize(N x u0), u_hat = v_hat x N; the u roughness\n";
+            *o += "  applies along u_hat. u0 parallel to N: mean roughness on both axes. }\n";
+            let _ = writeln!(o, "u0x : {}; u0y : {}; u0z : {};", num(x), num(y), num(z));
+            *o += "crx = NyP*u0z - NzP*u0y; cry = NzP*u0x - NxP*u0z; crz = NxP*u0y - NyP*u0x;\n";
+            *o += "crl = sqrt(crx*crx + cry*cry + crz*crz);\n";
+            *o += "vhx = if(crl, crx/crl, 0); vhy = if(crl, cry/crl, 0); vhz = if(crl, crz/crl, 0);\n";
+            *o += "uhx = vhy*NzP - vhz*NyP; uhy = vhz*NxP - vhx*NzP; uhz = vhx*NyP - vhy*NxP;\n";
+            *o += "w2u(t) = if(crl, sq(p_rough_u(t)), (sq(p_rough_u(t)) + sq(p_rough_v(t)))/2);\n";
+            *o += "w2v(t) = if(crl, sq(p_rough_v(t)), (sq(p_rough_u(t)) + sq(p_rough_v(t)))/2);\n";
+        }
+        *o += "\n";
+    }
+
+    /// Section 4: the split into specular, diffuse and transmitted parts
+    /// at `t` = θ_in (they depend on the view through the Fresnel terms).
+    fn coefficients(&self, o: &mut String) {
+        let radiance = self.variant == Variant::Radiance;
+        let ward = self.variant == Variant::Ward1992;
+        let metal = self.kind.is_metal();
+        *o += "{ ===== 4. Specular, diffuse and transmitted fractions at theta_in = t ===== }\n";
+        if self.iso() {
+            *o += "pure(t) : if(sq(p_rough(t)) - ftiny, -1, 1);   { roughness <= 0.001: mirror-like }\n";
+        }
+        let fresnel = radiance && self.iso();
+        if fresnel {
+            *o += "fresnel(t) : if(pure(t), if(.017999 - p_spec(t), -1, 1), -1);\n";
+            *o += "spec(t) = if(fresnel(t), p_spec(t) + fres(cosv)*(1 - p_spec(t)), p_spec(t));\n";
+        } else if ward && !metal {
+            *o += "spec(t) = p_spec(t) + e6*(1 - p_spec(t));\n";
+        } else {
+            *o += "spec(t) = p_spec(t);\n";
+        }
+        if ward && metal {
+            *o += "wspec(k, t) = col(k, t)*p_spec(t) + (1 - col(k, t)*p_spec(t))*e6;\n";
+        }
+        if self.transmitting() {
+            *o += "trn(t) = p_trans(t)*(1 - spec(t));\n";
+            *o += "tsp(t) = trn(t)*p_tspec(t);\n";
+            *o += "tdf(t) = trn(t) - tsp(t);\n";
+            *o += "rdf(t) = 1 - trn(t) - spec(t);\n";
+        } else {
+            *o += "rdf(t) = 1 - spec(t);\n";
+        }
+        if fresnel {
+            let diffuse_on = if self.transmitting() {
+                "or(rdf(t) - ftiny, tdf(t) - ftiny)"
+            } else {
+                "rdf(t) - ftiny"
+            };
+            let _ = writeln!(
+                o,
+                "lfres(c, t) = if(and(fresnel(t), {diffuse_on}), 1 - fres(c), 1);"
+            );
+        }
+        *o += "\n";
+    }
+
+    /// Section 5: the reflected (and transmitted) specular lobes.
+    fn lobes(&self, o: &mut String) {
+        let widen = "om/(4*PI)";
+        *o += "{ ===== 5. Specular lobes (no specularity or colour); c = |light cosine|,\n";
+        *o += "  h = l + v (not normalised), om = source solid angle. The reflected lobe is\n";
+        *o += "  widened by om/(4 pi) as rtrace does on flat surfaces. }\n";
+        if self.iso() {
+            let _ = writeln!(
+                o,
+                "lobe(c, hx, hy, hz, om, t) = lobe_h(c, hx*hx + hy*hy + hz*hz, hx*NxP + hy*NyP + hz*NzP, sq(p_rough(t)) + {widen});"
+            );
+            *o += match self.variant {
+                Variant::Radiance => {
+                    "lobe_h(c, hh, hn, w) = cutoff(ex((hh/(hn*hn) - 1)/w)*hh/(PI*w*sq(hn*hn)));\n"
+                }
+                Variant::Manual2004 => {
+                    "lobe_h(c, hh, hn, w) = ex((hh/(hn*hn) - 1)/w)/(4*PI*w*c*cosv);\n"
+                }
+                Variant::Ward1992 => {
+                    "lobe_h(c, hh, hn, w) = ex((2 - 2*hn/sqrt(hh))/w)/(4*PI*w*sqrt(c*cosv));\n"
+                }
+            };
+        } else {
+            let _ = writeln!(
+                o,
+                "lobe(c, hx, hy, hz, om, t) = lobe_h(c, hx*hx + hy*hy + hz*hz, hx*NxP + hy*NyP + hz*NzP,\n\
+                 \thx*uhx + hy*uhy + hz*uhz, hx*vhx + hy*vhy + hz*vhz, w2u(t) + {widen}, w2v(t) + {widen});"
+            );
+            *o += match self.variant {
+                Variant::Radiance => {
+                    "lobe_h(c, hh, hn, hu, hv, wu, wv) = cutoff(ex((hu*hu/wu + hv*hv/wv)/(hn*hn))*hh/(PI*sq(hn*hn)*sqrt(wu*wv)));\n"
+                }
+                Variant::Manual2004 => {
+                    "lobe_h(c, hh, hn, hu, hv, wu, wv) = ex((hu*hu/wu + hv*hv/wv)/(hn*hn))/(4*PI*sqrt(wu*wv)*c*cosv);\n"
+                }
+                Variant::Ward1992 => {
+                    "lobe_h(c, hh, hn, hu, hv, wu, wv) = ex(2*(hu*hu/wu + hv*hv/wv)/(hh*(1 + hn/sqrt(hh))))/(4*PI*sqrt(wu*wv)*sqrt(c*cosv));\n"
+                }
+            };
+        }
+        if self.transmitting() {
+            let geometry = match self.variant {
+                Variant::Manual2004 => "(c*cosv)",
+                _ => "sqrt(c*cosv)",
+            };
+            *o += "{ Transmitted lobe around the straight-through direction, widened by om/pi. }\n";
+            if self.iso() {
+                *o += "tlobe(c, hx, hy, hz, om, t) = tlobe_h(c, hx*hx + hy*hy + hz*hz, sq(p_rough(t)) + om/PI);\n";
+                let g = if self.variant == Variant::Radiance {
+                    "cutoff(ex(x/b)/(PI*b))"
+                } else {
+                    "ex(x/b)/(PI*b)"
+                };
+                let _ = writeln!(o, "tlobe_h(c, x, b) = {g}/{geometry};");
+            } else {
+                *o += "tlobe(c, hx, hy, hz, om, t) = tlobe_h(c, hx*hx + hy*hy + hz*hz, hx*NxP + hy*NyP + hz*NzP,\n\
+                       \thx*uhx + hy*uhy + hz*uhz, hx*vhx + hy*vhy + hz*vhz, w2u(t) + om/PI, w2v(t) + om/PI);\n";
+                *o += "tlobe_h(c, hh, hn, hu, hv, bu, bv) = tlobe_e(c, ex(tl_x(tl_s2(hh, hn), hu, hv, bu, bv)), bu, bv);\n";
+                *o += "tl_s2(hh, hn) = if(hh - 1e-12, 1 - hn*hn/hh, hh);\n";
+                *o += "tl_x(s2, hu, hv, bu, bv) = if(s2 - 1e-12, (hu*hu/bu + hv*hv/bv)/s2, 0);\n";
+                if self.variant == Variant::Radiance {
+                    let _ = writeln!(
+                        o,
+                        "tlobe_e(c, e, bu, bv) = if(e*sqrt(c/(cosv*bu*bv))/PI - ftiny, e/(PI*sqrt(bu*bv)*{geometry}), 0);"
+                    );
+                } else {
+                    let _ = writeln!(o, "tlobe_e(c, e, bu, bv) = e/(PI*sqrt(bu*bv)*{geometry});");
+                }
+            }
+        }
+        *o += "\n";
+    }
+
+    /// Section 6 for `BRTDfunc`: the whole BSDF per channel.
+    fn brtd_entry(&self, o: &mut String, rd0: [f64; 3], td0: [f64; 3], deltas: bool) {
+        let ward_metal = self.variant == Variant::Ward1992 && self.kind.is_metal();
+        let lfres = if self.variant == Variant::Radiance && self.iso() {
+            "*lfres(c, t)"
+        } else {
+            ""
+        };
+        let not_pure = |cond: &str| {
+            if self.iso() {
+                format!("and(-pure(t), {cond})")
+            } else {
+                cond.to_string()
+            }
+        };
+        *o +=
+            "{ ===== 6. The BSDF f(l, v) in 1/sr for channel k (1 red, 2 green, 3 blue) ===== }\n";
+        *o += "bsdf(k, lx, ly, lz, om) = bsdf_c(k, cosl(lx, ly, lz), lx + vx, ly + vy, lz + vz, om);\n";
+        if self.transmitting() {
+            *o += "bsdf_c(k, c, hx, hy, hz, om) = if(c, refl(k, c, hx, hy, hz, om, thin(c)),\n\
+                   \tif(-c, trans(k, -c, hx, hy, hz, om, thin(c)), 0));\n";
+            *o += "refl(k, c, hx, hy, hz, om, t) = if(trn(t) - (1 - ftiny), 0,\n\
+                   \trdiff(k, c, t) + rspec(k, c, hx, hy, hz, om, t));\n";
+        } else {
+            *o += "bsdf_c(k, c, hx, hy, hz, om) = if(c, refl(k, c, hx, hy, hz, om, thin(c)), 0);\n";
+            *o += "refl(k, c, hx, hy, hz, om, t) = rdiff(k, c, t) + rspec(k, c, hx, hy, hz, om, t);\n";
+        }
+        if ward_metal {
+            *o += "rdiff(k, c, t) = col(k, t)*(1 - wspec(k, t))/PI;\n";
+        } else {
+            let _ = writeln!(
+                o,
+                "rdiff(k, c, t) = if(rdf(t) - ftiny, col(k, t)*rdf(t){lfres}/PI, 0);"
+            );
+        }
+        let (on, colour) = if ward_metal {
+            ("p_spec(t) - ftiny", "wspec(k, t)")
+        } else if self.kind.is_metal() {
+            ("spec(t) - ftiny", "col(k, t)*p_spec(t)")
+        } else {
+            ("spec(t) - ftiny", "spec(t)")
+        };
+        let _ = writeln!(
+            o,
+            "rspec(k, c, hx, hy, hz, om, t) = if({}, {colour}*lobe(c, hx, hy, hz, om, t), 0);",
+            not_pure(on)
+        );
+        if self.transmitting() {
+            *o += "trans(k, c, hx, hy, hz, om, t) = if(trn(t) - ftiny,\n\
+                   \ttdiff(k, c, t) + tspec(k, c, hx, hy, hz, om, t), 0);\n";
+            let _ = writeln!(
+                o,
+                "tdiff(k, c, t) = if(tdf(t) - ftiny, col(k, t)*tdf(t){lfres}/PI, 0);"
+            );
+            let _ = writeln!(
+                o,
+                "tspec(k, c, hx, hy, hz, om, t) = if({}, col(k, t)*tsp(t)*tlobe(c, hx, hy, hz, om, t), 0);",
+                not_pure("tsp(t) - ftiny")
+            );
+        }
+        *o += "\n{ ===== 7. What BRTDfunc calls =====\n";
+        *o += "  The material's real arguments hold constant diffuse parts (the smallest over\n";
+        *o += "  theta_in, so they also serve indirect light); the functions add the rest. }\n";
+        let channel = ["red", "green", "blue"];
+        for (k, name) in channel.iter().enumerate() {
+            let _ = writeln!(
+                o,
+                "rd0_{name} : {}; td0_{name} : {};",
+                num(rd0[k]),
+                num(td0[k])
+            );
+        }
+        for (k, name) in channel.iter().enumerate() {
+            let _ = writeln!(
+                o,
+                "{}(lx, ly, lz, om) = bsdf({}, lx, ly, lz, om) - if(cosl(lx, ly, lz), rd0_{name}, td0_{name})/PI;",
+                CHANNEL_FUNCTIONS[k],
+                k + 1
+            );
+        }
+        if deltas {
+            *o += "\n{ Roughness 0: mirror and straight-through coefficients, at the view's theta. }\n";
+            *o += "tview = acos(min(1, RdotP))/DEGREE;\n";
+            let mirror = if self.kind.is_metal() {
+                if self.variant == Variant::Radiance {
+                    "if(and(fresnel(t), fres(cosv) - ftiny), fres(cosv) + col(k, t)*p_spec(t)*(1 - fres(cosv)), col(k, t)*p_spec(t))"
+                } else {
+                    "col(k, t)*p_spec(t)"
+                }
+            } else {
+                "spec(t)"
+            };
+            let _ = writeln!(o, "mirror(k, t) = if(pure(t), {mirror}, 0);");
+            for (k, var) in MIRROR_VARIABLES.iter().enumerate() {
+                let _ = writeln!(o, "{var} = mirror({}, tview);", k + 1);
+            }
+            if self.transmitting() {
+                *o += "through(k, t) = if(pure(t), col(k, t)*tsp(t), 0);\n";
+                for (k, var) in THROUGH_VARIABLES.iter().enumerate() {
+                    let _ = writeln!(o, "{var} = through({}, tview);", k + 1);
+                }
+            }
+        }
+    }
+
+    /// Section 6 for `plasfunc`/`metfunc`/`transfunc`: the lobes alone;
+    /// Radiance multiplies them by the constant specular fractions.
+    fn lobe_entry(&self, o: &mut String) {
+        *o += "{ ===== 6. What the material calls: the specular lobe at the light's theta_in.\n";
+        *o +=
+            "  Radiance scales it by the constant specularity (and colour, for metals) and adds\n";
+        *o += "  the constant diffuse parts itself. }\n";
+        let _ = writeln!(
+            o,
+            "{LOBE_FUNCTION}(lx, ly, lz, om) = lobe_c(cosl(lx, ly, lz), lx + vx, ly + vy, lz + vz, om);"
+        );
+        if self.transmitting() {
+            *o += "lobe_c(c, hx, hy, hz, om) = if(c, lobe(c, hx, hy, hz, om, thin(c)),\n\
+                   \tif(-c, tlobe(-c, hx, hy, hz, om, thin(c)), 0));\n";
+        } else {
+            *o += "lobe_c(c, hx, hy, hz, om) = if(c, lobe(c, hx, hy, hz, om, thin(c)), 0);\n";
+        }
+    }
+}

@@ -1,0 +1,275 @@
+//! Radiance exports of a fit: what `brtf export` (and the end of
+//! `brtf fit`) writes into the fit folder.
+//!
+//! | file | what |
+//! |---|---|
+//! | `<name>.rad` | the **static** material: one `plastic`/`metal`/`trans` (or `*2`) primitive from the all-incidence fit, or from the table at a chosen θ_in, with a comment header (provenance, fit quality, variant, caveats) |
+//! | `<name>-theta.rad` | the **θ_in-dependent** material: a `BRTDfunc` (or `plasfunc`/`metfunc`/`transfunc` when they suffice) with the same identifier |
+//! | `<name>-theta.cal` | its function file: the parameter table as exact cubic segments and brtf-model's BSDF in Radiance's function language |
+//! | `<name>-preview.rad` | a small scene (sphere and floor under a sun and a sky) that either material file can be rendered with |
+//!
+//! Everything is built in memory first ([`exports`]); [`write_exports`]
+//! then writes each file atomically (a temporary file in the same folder,
+//! renamed into place). `docs/radiance.md` explains how to use the files.
+
+mod cal;
+mod num;
+mod pieces;
+mod preview;
+mod report;
+mod static_material;
+mod theta;
+
+use brtf_fit::{FitReport, FitResult};
+use brtf_model::{Material, MaterialKind, ModelError};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// What to export.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExportOptions {
+    /// Material identifier and file stem. `None`: the fit's name (with
+    /// characters Radiance cannot take replaced by `_`).
+    pub name: Option<String>,
+    /// Take the static material from the parameters at this θ_in
+    /// (degrees) instead of the all-incidence fit.
+    pub at: Option<f64>,
+    /// Write the θ_in-dependent material (needs two incidences or more).
+    pub theta_dependent: bool,
+    /// Write the preview scene.
+    pub preview: bool,
+}
+
+impl Default for ExportOptions {
+    fn default() -> Self {
+        ExportOptions {
+            name: None,
+            at: None,
+            theta_dependent: true,
+            preview: true,
+        }
+    }
+}
+
+/// Why the exports could not be made.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ExportError {
+    /// The fit result holds neither an all-incidence fit nor any incidence.
+    #[error("the fit result holds no fitted parameters (no all-incidence fit and no incidence)")]
+    NoParameters,
+    /// Fitted arguments do not make a valid material.
+    #[error("the fitted parameters of {what} are not a valid {kind}: {source}")]
+    Material {
+        /// Which parameter set.
+        what: String,
+        /// The material type.
+        kind: MaterialKind,
+        /// What is wrong.
+        source: ModelError,
+    },
+    /// `--at` cannot be served.
+    #[error("--at {theta}: {reason}")]
+    At {
+        /// The requested θ_in.
+        theta: f64,
+        /// Why not.
+        reason: String,
+    },
+    /// The material name cannot be a Radiance identifier and file stem.
+    #[error(
+        "material name `{0}` cannot be used: give letters, digits, `_`, `-` or `.` (not first)"
+    )]
+    BadName(String),
+    /// A file could not be written.
+    #[error("cannot write {}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+}
+
+/// One exported file, in memory.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExportFile {
+    /// File name (no folder).
+    pub file_name: String,
+    /// Its text.
+    pub text: String,
+}
+
+/// All exports of a fit, in memory.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Export {
+    /// The material identifier used in every file.
+    pub name: String,
+    /// The files, static material first.
+    pub files: Vec<ExportFile>,
+    /// Things the user should know (skipped exports, caveats), one line each.
+    pub notes: Vec<String>,
+}
+
+/// What [`write_exports`] wrote.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Exported {
+    /// The files written, static material first.
+    pub files: Vec<PathBuf>,
+    /// Things the user should know, one line each.
+    pub notes: Vec<String>,
+}
+
+/// File name of the static material.
+pub fn static_file_name(name: &str) -> String {
+    format!("{name}.rad")
+}
+
+/// File name of the θ_in-dependent material.
+pub fn theta_file_name(name: &str) -> String {
+    format!("{name}-theta.rad")
+}
+
+/// File name of the θ_in-dependent material's function file.
+pub fn cal_file_name(name: &str) -> String {
+    format!("{name}-theta.cal")
+}
+
+/// File name of the preview scene.
+pub fn preview_file_name(name: &str) -> String {
+    format!("{name}-preview.rad")
+}
+
+/// Builds every export of `result` in memory.
+pub fn exports(result: &FitResult, options: &ExportOptions) -> Result<Export, ExportError> {
+    let name = material_name(result, options)?;
+    let chosen = static_material::choose(result, options.at)?;
+    let mut files = Vec::new();
+    let mut notes = Vec::new();
+    let theta = match (&result.table, options.theta_dependent) {
+        (Some(table), true) => Some(theta::build(result, table, &name)?),
+        (None, true) => {
+            notes.push(format!(
+                "no θ_in-dependent material: the fit has {} incidence(s), interpolation needs two",
+                result.incidences.len()
+            ));
+            None
+        }
+        (_, false) => None,
+    };
+    let stat = static_material::text(result, &chosen, &name, theta.is_some());
+    notes.extend(stat.notes);
+    files.push(ExportFile {
+        file_name: static_file_name(&name),
+        text: stat.text,
+    });
+    if let Some(theta) = theta {
+        notes.extend(theta.notes);
+        files.push(ExportFile {
+            file_name: theta_file_name(&name),
+            text: theta.rad,
+        });
+        files.push(ExportFile {
+            file_name: cal_file_name(&name),
+            text: theta.cal,
+        });
+    }
+    if options.preview {
+        files.push(ExportFile {
+            file_name: preview_file_name(&name),
+            text: preview::text(result, &name, files.len() > 1),
+        });
+    }
+    Ok(Export { name, files, notes })
+}
+
+/// Writes every export of `result` into `dir` (which must exist), each file
+/// atomically. Returns the paths written, static material first.
+pub fn write_exports(
+    dir: &Path,
+    result: &FitResult,
+    options: &ExportOptions,
+) -> Result<Exported, ExportError> {
+    let export = exports(result, options)?;
+    let mut files = Vec::with_capacity(export.files.len());
+    for file in &export.files {
+        let path = dir.join(&file.file_name);
+        write_atomically(&path, file.text.as_bytes())?;
+        files.push(path);
+    }
+    Ok(Exported {
+        files,
+        notes: export.notes,
+    })
+}
+
+/// Writes `bytes` to a temporary file next to `path`, then renames it.
+fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), ExportError> {
+    let io = |source| ExportError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let dir = path.parent().filter(|d| !d.as_os_str().is_empty());
+    let file_name = path
+        .file_name()
+        .map_or_else(|| "export".into(), |n| n.to_string_lossy().into_owned());
+    let tmp = dir
+        .unwrap_or(Path::new("."))
+        .join(format!(".{file_name}.{}.tmp", std::process::id()));
+    let write = || -> std::io::Result<()> {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    };
+    write().map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        io(e)
+    })
+}
+
+/// The identifier: `--name` (checked) or the fit's name (sanitised).
+fn material_name(result: &FitResult, options: &ExportOptions) -> Result<String, ExportError> {
+    let ok_char = |c: char| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.');
+    if let Some(name) = &options.name {
+        if name.is_empty() || !name.chars().all(ok_char) || name.starts_with(['-', '.']) {
+            return Err(ExportError::BadName(name.clone()));
+        }
+        return Ok(name.clone());
+    }
+    // The fit's name may be a folder path: keep its last component.
+    let base = result
+        .name
+        .rsplit(['/', '\\'])
+        .find(|s| !s.is_empty())
+        .unwrap_or("");
+    let mut name: String = base
+        .chars()
+        .map(|c| if ok_char(c) { c } else { '_' })
+        .collect();
+    while name.starts_with(['-', '.']) {
+        name.remove(0);
+    }
+    if name.is_empty() {
+        name = "material".into();
+    }
+    Ok(name)
+}
+
+/// The material of a fitted report, or a located error.
+fn material_of(
+    result: &FitResult,
+    report: &FitReport,
+    what: &str,
+) -> Result<Material, ExportError> {
+    Material::new(
+        result.config.kind,
+        &report.material_args,
+        Some(glam::DVec3::from_array(result.config.orientation)),
+    )
+    .map_err(|source| ExportError::Material {
+        what: what.to_string(),
+        kind: result.config.kind,
+        source,
+    })
+}

@@ -1,0 +1,398 @@
+//! The θ_in-dependent material: `<name>-theta.rad` and its function file
+//! `<name>-theta.cal`.
+//!
+//! The parameters follow the fitted θ_in table, evaluated at the θ_in of
+//! each light source sample (`acos |l·n|`). The material is a `BRTDfunc`
+//! whose three channel functions compute brtf-model's BSDF; its real
+//! arguments keep, as constant diffuse parts, the smallest diffuse
+//! reflectance and transmittance over θ_in, so that indirect light still
+//! reaches the diffuse part (the functions add the rest). When only the
+//! roughness changes with θ_in, Radiance's own `plasfunc`/`metfunc`/
+//! `transfunc` suffice: their constant arguments carry colour,
+//! specularity and transmission, and the function only the lobe.
+
+use super::cal::{
+    CHANNEL_FUNCTIONS, CalModel, Entry, LOBE_FUNCTION, MIRROR_VARIABLES, THROUGH_VARIABLES,
+};
+use super::num::sig;
+use super::pieces::Pieces;
+use super::report::{self, ascii};
+use super::static_material::comment_block;
+use super::{ExportError, cal_file_name, theta_file_name};
+use crate::primitive::{Primitive, format_primitive};
+use brtf_fit::{FitResult, ParamTable};
+use brtf_model::{FTINY, Material, MaterialKind, Variant};
+use glam::DVec3;
+
+/// Samples per table segment when searching minima over θ_in.
+const GRID_PER_SEGMENT: usize = 400;
+/// Rtrace's Fresnel switch (specularity at or above it, roughness 0).
+const FRESNEL_THRESHOLD: f64 = 0.017999;
+/// The constant diffuse parts are this fraction of the smallest diffuse
+/// reflectance over θ_in, so the functions' remainder stays positive.
+const FLOOR_MARGIN: f64 = 1.0 - 1e-4;
+
+/// The two files and notes for the user.
+pub(crate) struct Theta {
+    pub rad: String,
+    pub cal: String,
+    pub notes: Vec<String>,
+}
+
+/// Builds both files from the table.
+pub(crate) fn build(
+    result: &FitResult,
+    table: &ParamTable,
+    name: &str,
+) -> Result<Theta, ExportError> {
+    let kind = table.kind;
+    let options = result.options();
+    let variant = options.variant;
+    check_rows(table)?;
+    let pieces = Pieces::of(table);
+    let grid = grid(table);
+    let iso = !kind.is_anisotropic();
+    let any_pure = iso && grid.iter().any(|a| a[4] * a[4] <= FTINY);
+    let lobe_only = variant != Variant::Ward1992 && !any_pure && only_roughness_varies(table);
+    let entry = if lobe_only {
+        Entry::Lobe
+    } else {
+        let (rd0, td0) = diffuse_floor(kind, variant, &grid);
+        Entry::Brtd {
+            rd0,
+            td0,
+            deltas: any_pure,
+        }
+    };
+    let model = CalModel {
+        kind,
+        variant,
+        fresnel_k: options.fresnel_k,
+        orientation: table.orientation,
+        pieces: &pieces,
+        entry,
+    };
+    let cal_name = cal_file_name(name);
+    let (lo, hi) = table.range();
+    let rows = table.theta_in.len();
+    let mut notes = Vec::new();
+    if any_pure {
+        notes.push(format!(
+            "{}: some θ_in have roughness 0; their mirror part is a traced ray",
+            theta_file_name(name)
+        ));
+    }
+
+    // ---- the .cal file ----
+    let mut ch = vec![
+        format!(
+            "{cal_name}: function file of the theta_in-dependent Radiance material \"{name}\"",
+            cal_name = cal_name
+        ),
+        format!(
+            "({kind}, variant {variant}), written by brtf {} (brtf export). Used by {}.",
+            env!("CARGO_PKG_VERSION"),
+            theta_file_name(name)
+        ),
+        String::new(),
+    ];
+    ch.extend(report::provenance(result));
+    ch.push(String::new());
+    ch.push(format!(
+        "The table: {rows} incidences, theta_in {lo}-{hi} deg, {:?} interpolation.",
+        table.method
+    ));
+    ch.push(format!(
+        "  theta_in  {}",
+        kind.param_names()
+            .iter()
+            .map(|n| format!("{n:>9}"))
+            .collect::<Vec<_>>()
+            .join(" ")
+    ));
+    for (theta, args) in table.theta_in.iter().zip(&table.args) {
+        ch.push(format!(
+            "  {:>8}  {}",
+            sig(*theta, 4),
+            args.iter()
+                .map(|a| format!("{:>9}", sig(*a, 5)))
+                .collect::<Vec<_>>()
+                .join(" ")
+        ));
+    }
+    ch.push("Fit quality per incidence:".into());
+    ch.extend(report::incidences(result));
+    ch.push(String::new());
+    ch.push(
+        "theta_in is the angle between the surface normal and the direction to the light".into(),
+    );
+    ch.push("source sample, on whichever side the light is (two-sided, like plastic).".into());
+    let cal = model.text(&ch);
+
+    // ---- the .rad file ----
+    let grey = model.grey();
+    let mut h = vec![
+        format!(
+            "{}: theta_in-dependent Radiance material \"{name}\" ({kind}, variant {variant}),",
+            theta_file_name(name)
+        ),
+        format!(
+            "written by brtf {} (brtf export) from fit \"{}\" created {}.",
+            env!("CARGO_PKG_VERSION"),
+            ascii(&result.name),
+            result.provenance.created
+        ),
+        String::new(),
+        format!(
+            "Parameters: the fitted table ({rows} incidences, theta_in {lo}-{hi} deg, {:?}),",
+            table.method
+        ),
+        "evaluated at theta_in = the angle between the surface normal and the direction to".into(),
+        "each light source sample (outside the measured range the end values hold).".into(),
+        format!(
+            "Function file: {cal_name}. Radiance finds it through RAYPATH: render in this folder,"
+        ),
+        "or add the folder to RAYPATH (docs/radiance.md).".into(),
+        String::new(),
+    ];
+    let primitive = match entry {
+        Entry::Lobe => {
+            let radiance_type = match kind {
+                MaterialKind::Plastic | MaterialKind::Plastic2 => "plasfunc",
+                MaterialKind::Metal | MaterialKind::Metal2 => "metfunc",
+                MaterialKind::Trans | MaterialKind::Trans2 => "transfunc",
+            };
+            let args = &table.args[0];
+            let mut reals = vec![args[0], args[1], args[2], args[3]];
+            if let (Some(t), Some(ts)) = trans_indices(kind) {
+                reals.extend([args[t], args[ts]]);
+            }
+            h.push(format!(
+                "Material: {radiance_type}. Only the roughness changes with theta_in, so the real"
+            ));
+            h.push(format!(
+                "arguments hold the constant colour, specularity{} and the function",
+                if kind.is_transmitting() {
+                    ", transmissivity and transmitted-specular fraction"
+                } else {
+                    ""
+                }
+            ));
+            h.push(format!(
+                "{LOBE_FUNCTION} the specular lobe at the light's theta_in ({variant} formulas)."
+            ));
+            h.push(String::new());
+            h.push("Compared with a static material:".into());
+            h.push(
+                "  - the specular lobe reflects light sources only (direct light); indirect light"
+                    .into(),
+            );
+            h.push(
+                "    reaches the material through its constant diffuse and specular fractions."
+                    .into(),
+            );
+            Primitive {
+                modifier: "void".into(),
+                kind: radiance_type.into(),
+                name: name.into(),
+                strings: vec![LOBE_FUNCTION.into(), cal_name.clone()],
+                ints: Vec::new(),
+                reals,
+                line: 0,
+            }
+        }
+        Entry::Brtd { rd0, td0, deltas } => {
+            let pick = |names: [&str; 3]| -> Vec<String> {
+                if grey {
+                    vec![names[0].to_string(); 3]
+                } else {
+                    names.iter().map(|s| s.to_string()).collect()
+                }
+            };
+            let mut strings = Vec::new();
+            if deltas {
+                strings.extend(pick(MIRROR_VARIABLES));
+            } else {
+                strings.extend(["0", "0", "0"].map(String::from));
+            }
+            if deltas && kind.is_transmitting() {
+                strings.extend(pick(THROUGH_VARIABLES));
+            } else {
+                strings.extend(["0", "0", "0"].map(String::from));
+            }
+            strings.extend(pick(CHANNEL_FUNCTIONS));
+            strings.push(cal_name.clone());
+            let mut reals = Vec::with_capacity(9);
+            reals.extend(rd0);
+            reals.extend(rd0);
+            reals.extend(td0);
+            h.push(format!(
+                "Material: BRTDfunc. Its functions compute brtf-model's {kind} BSDF ({variant} formulas)"
+            ));
+            h.push("with the parameters at the light's theta_in. The real arguments are constant diffuse".into());
+            h.push("parts: front and back reflectance, then transmittance, each the smallest over theta_in;".into());
+            h.push("the functions add the rest.".into());
+            if deltas {
+                h.push("Roughness-0 incidences: the mirror (and straight-through) coefficients use the".into());
+                h.push("parameters at the view's theta, as for a mirror ray.".into());
+            }
+            h.push(String::new());
+            h.push("Compared with a static material:".into());
+            h.push("  - the specular lobe, and the theta_in-dependent part of the diffuse term, respond".into());
+            h.push(
+                "    to light sources only (direct light); indirect light (-ab) reaches only the"
+                    .into(),
+            );
+            h.push("    constant diffuse parts in the real arguments;".into());
+            h.push("  - no Monte-Carlo sampling of the specular lobe: other objects do not appear in the".into());
+            h.push("    glossy reflection (or transmission).".into());
+            Primitive {
+                modifier: "void".into(),
+                kind: "BRTDfunc".into(),
+                name: name.into(),
+                strings,
+                ints: Vec::new(),
+                reals,
+                line: 0,
+            }
+        }
+    };
+    h.push(
+        "  - the reflected lobe is widened by the source size (omega/4pi) on every surface,".into(),
+    );
+    h.push("    as rtrace does for flat ones only, and -dj does not reduce it.".into());
+    h.push(String::new());
+    h.push(
+        "Reciprocity: the parameters depend on the light's direction, so f(l, v) and f(v, l)"
+            .into(),
+    );
+    h.push("differ: light sources play the role of the gonio-photometer's lamp. Tools that".into());
+    h.push("exchange the roles (mkillum secondary sources, light traced from the eye) see".into());
+    h.push("theta_in from their own light direction.".into());
+    if variant != Variant::Radiance {
+        h.push(String::new());
+        h.push(format!(
+            "Variant {variant}: the functions evaluate the {variant} formulas that were fitted, not"
+        ));
+        h.push("what rtrace computes for a static material with the same parameters.".into());
+    }
+    h.push(String::new());
+    h.push(format!(
+        "Same identifier as {}: give oconv one or the other.",
+        super::static_file_name(name)
+    ));
+    let mut rad = comment_block(&h);
+    rad += &format_primitive(&primitive);
+    Ok(Theta { rad, cal, notes })
+}
+
+/// Every table row must be a valid material of the table's type.
+fn check_rows(table: &ParamTable) -> Result<(), ExportError> {
+    let orientation = DVec3::from_array(table.orientation);
+    for (theta, args) in table.theta_in.iter().zip(&table.args) {
+        Material::new(table.kind, args, Some(orientation)).map_err(|source| {
+            ExportError::Material {
+                what: format!("the table row θ_in = {theta}"),
+                kind: table.kind,
+                source,
+            }
+        })?;
+    }
+    Ok(())
+}
+
+/// Interpolated arguments on a fine θ_in grid (nodes included).
+fn grid(table: &ParamTable) -> Vec<Vec<f64>> {
+    let mut out = Vec::new();
+    for w in table.theta_in.windows(2) {
+        for j in 0..GRID_PER_SEGMENT {
+            let t = w[0] + (w[1] - w[0]) * j as f64 / GRID_PER_SEGMENT as f64;
+            out.push(table.args_at(t).0);
+        }
+    }
+    if let Some(&last) = table.theta_in.last() {
+        out.push(table.args_at(last).0);
+    }
+    out
+}
+
+/// Indices of the transmissivity and transmitted-specular fraction.
+fn trans_indices(kind: MaterialKind) -> (Option<usize>, Option<usize>) {
+    match kind {
+        MaterialKind::Trans => (Some(5), Some(6)),
+        MaterialKind::Trans2 => (Some(6), Some(7)),
+        _ => (None, None),
+    }
+}
+
+/// True when every argument but the roughness is the same in every row.
+fn only_roughness_varies(table: &ParamTable) -> bool {
+    let first = &table.args[0];
+    table
+        .kind
+        .param_names()
+        .iter()
+        .enumerate()
+        .all(|(j, name)| {
+            name.starts_with("rough")
+                || table
+                    .args
+                    .iter()
+                    .all(|row| (row[j] - first[j]).abs() <= 1e-12 * first[j].abs().max(1.0))
+        })
+}
+
+/// The smallest diffuse reflectance and transmittance (per channel) over
+/// θ_in and over every view, times a small margin: the constant parts of
+/// the `BRTDfunc`.
+fn diffuse_floor(kind: MaterialKind, variant: Variant, grid: &[Vec<f64>]) -> ([f64; 3], [f64; 3]) {
+    let mut rd = [f64::INFINITY; 3];
+    let mut td = [f64::INFINITY; 3];
+    // The view-dependent Fresnel terms are largest at the clamped view cosine.
+    let e6 = (-6.0f64 * 0.001).exp();
+    let (it, its) = trans_indices(kind);
+    for a in grid {
+        let c = [a[0], a[1], a[2]];
+        let rs = a[3];
+        let pure = !kind.is_anisotropic() && a[4] * a[4] <= FTINY;
+        let (r, t) = if variant == Variant::Radiance && pure && rs >= FRESNEL_THRESHOLD {
+            // The Fresnel factors reach ~0 at grazing angles.
+            ([0.0; 3], [0.0; 3])
+        } else if variant == Variant::Ward1992 && kind.is_metal() {
+            (
+                c.map(|ck| ck * (1.0 - (ck * rs + (1.0 - ck * rs) * e6))),
+                [0.0; 3],
+            )
+        } else {
+            let s = if variant == Variant::Ward1992 {
+                rs + e6 * (1.0 - rs)
+            } else {
+                rs
+            };
+            let trans = it.map_or(0.0, |i| a[i] * (1.0 - s));
+            let tspec = its.map_or(0.0, |i| a[i]);
+            let r_d = 1.0 - trans - s;
+            let t_d = trans * (1.0 - tspec);
+            let r_on = r_d > FTINY && trans < 1.0 - FTINY;
+            let t_on = t_d > FTINY && trans > FTINY;
+            (
+                c.map(|ck| if r_on { ck * r_d } else { 0.0 }),
+                c.map(|ck| if t_on { ck * t_d } else { 0.0 }),
+            )
+        };
+        for k in 0..3 {
+            rd[k] = rd[k].min(r[k]);
+            td[k] = td[k].min(t[k]);
+        }
+    }
+    let finish = |x: [f64; 3]| {
+        x.map(|v| {
+            if v.is_finite() {
+                (v * FLOOR_MARGIN).max(0.0)
+            } else {
+                0.0
+            }
+        })
+    };
+    (finish(rd), finish(td))
+}
