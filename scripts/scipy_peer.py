@@ -72,6 +72,12 @@ def main():
                                ftol=1e-12, xtol=1e-12, gtol=1e-14)
         times.append(time.perf_counter() - t0)
     c, rs, a = result.x
+    if len(sys.argv) > 3:
+        import json
+        with open(sys.argv[3]) as f:
+            brtf_ms = json.load(f)["median"]["point_estimate"] / 1e6
+        print(f"brtf (criterion median): {brtf_ms:.1f} ms; scipy median {1e3 * np.median(times):.1f} ms; "
+              f"ratio {1e3 * np.median(times) / brtf_ms:.1f}x")
     print(f"scipy least_squares (trf, analytic jacobian): median {1e3 * np.median(times):.1f} ms "
           f"over {runs} runs; colour {c:.5f} spec {rs:.5f} rough {a:.5f} cost {result.cost:.6e} "
           f"nfev {result.nfev}")

@@ -71,8 +71,10 @@ fn write_peer_data(data: &IncidenceData) {
 fn bench_fit(c: &mut Criterion) {
     let (_, data) = bench_data();
     write_peer_data(&data);
+    // The same residuals as the scipy peer: relative, with the auto floor.
     let mut config = FitConfig::new(MaterialKind::Metal);
     config.gray = true;
+    config.residual = brtf_fit::ResidualKind::Relative;
     let report = fit_incidence(&data, &config).unwrap();
     eprintln!(
         "metal 120k: spec {:.5} rough {:.5} colour {:.5} cost {:.6e} evals {} ({:?})",
