@@ -7,6 +7,7 @@ use brtf_model::{Bsdf, EvalOptions, Gradient, Material};
 use glam::DVec3;
 use levenberg_marquardt::LeastSquaresProblem;
 use nalgebra::{DMatrix, DVector, Dyn, Owned};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::cell::{Cell, RefCell};
 
@@ -89,17 +90,6 @@ impl Problem<'_> {
         Some((p, dp, material, scale))
     }
 
-    /// Residual for model `m` and measured `y` with factor `k`, and dr/dm.
-    #[inline(always)]
-    fn residual(&self, m: f64, y: f64, k: f64) -> (f64, f64) {
-        match self.kind {
-            ResidualKind::Absolute | ResidualKind::Relative => (k * (m - y), k),
-            ResidualKind::Log => {
-                let a = m.max(0.0) + self.floor;
-                (k * (a.ln() - (y.max(0.0) + self.floor).ln()), k / a)
-            }
-        }
-    }
 
     pub(crate) fn residual_vector(&self, u: &DVector<f64>) -> Option<DVector<f64>> {
         self.evaluate::<false>(u).map(|e| e.residuals)
@@ -111,49 +101,55 @@ impl Problem<'_> {
 
     /// Residuals, and with `JACOBIAN` the Jacobian on the same pass (one
     /// BSDF evaluation per sample serves both), plus the unweighted RMS of
-    /// `(m − y)/sqrt(y² + floor²)` reported as `rms_rel`.
+    /// `(m − y)/sqrt(y² + floor²)` reported as `rms_rel`. Large problems
+    /// are split into fixed chunks evaluated in parallel; the chunking and
+    /// the order of the final sums do not depend on the thread count, so
+    /// results are deterministic.
     pub(crate) fn evaluate<const JACOBIAN: bool>(&self, u: &DVector<f64>) -> Option<Evaluation> {
         let (_, dp, material, scale) = self.physical(u)?;
         let bsdf = Bsdf::new(&material, &self.options);
         let n = self.map.len();
         let m = self.n_residuals();
-        let columns: Vec<(Target, f64)> = self
-            .map
-            .slots
-            .iter()
-            .zip(&dp)
-            .map(|(s, &d)| (s.target, d))
-            .collect();
-        let mut residuals = DVector::zeros(m);
-        let mut jac = if JACOBIAN {
-            DMatrix::zeros(m, n)
-        } else {
-            DMatrix::zeros(0, 0)
-        };
-        let mut jac_columns: Vec<&mut [f64]> = if JACOBIAN {
-            jac.as_mut_slice().chunks_mut(m).collect()
-        } else {
-            Vec::new()
-        };
-        let mut grad = Gradient::default();
+        let channels = self.channels;
+        let columns: Vec<(Target, f64)> =
+            self.map.slots.iter().zip(&dp).map(|(s, &d)| (s.target, d)).collect();
+        // (block, first sample, end sample, first row)
+        let mut chunks = Vec::new();
         let mut row = 0;
-        let mut sum_rel = 0.0;
-        let floor2 = self.floor * self.floor;
-        for block in self.blocks {
-            for ((v, y), k) in block.views.iter().zip(&block.values).zip(&block.factors) {
+        for (b, block) in self.blocks.iter().enumerate() {
+            let mut start = 0;
+            while start < block.len() {
+                let end = (start + CHUNK).min(block.len());
+                chunks.push((b, start, end, row));
+                row += (end - start) * channels;
+                start = end;
+            }
+        }
+        let (floor, kind, blocks) = (self.floor, self.kind, self.blocks);
+        let floor2 = floor * floor;
+        let run_chunk = |&(b, start, end, _): &(usize, usize, usize, usize)| {
+            let block = &blocks[b];
+            let rows = (end - start) * channels;
+            let mut r = Vec::with_capacity(rows);
+            // Row-major n entries per row.
+            let mut j = Vec::with_capacity(if JACOBIAN { rows * n } else { 0 });
+            let mut grad = Gradient::default();
+            let mut sum_rel = 0.0;
+            for i in start..end {
+                let (v, y, k) = (block.views[i], &block.values[i], &block.factors[i]);
                 let f = if JACOBIAN {
-                    bsdf.eval_with_gradient(block.light, *v, &mut grad)
+                    bsdf.eval_with_gradient(block.light, v, &mut grad)
                 } else {
-                    bsdf.eval(block.light, *v)
+                    bsdf.eval(block.light, v)
                 };
-                for ch in 0..self.channels {
+                for ch in 0..channels {
                     let model = scale * f[ch];
-                    let (r, dr_dm) = self.residual(model, y[ch], k[ch]);
-                    residuals[row] = r;
+                    let (res, dr_dm) = residual(kind, floor, model, y[ch], k[ch]);
+                    r.push(res);
                     let e = model - y[ch];
                     sum_rel += e * e / (y[ch] * y[ch] + floor2);
                     if JACOBIAN {
-                        for (column, &(target, dp_du)) in jac_columns.iter_mut().zip(&columns) {
+                        for &(target, dp_du) in &columns {
                             let dm_dp = match target {
                                 Target::Arg(a) => scale * grad.d[a][ch],
                                 Target::Gray => {
@@ -161,14 +157,33 @@ impl Problem<'_> {
                                 }
                                 Target::Scale => f[ch],
                             };
-                            column[row] = dr_dm * dm_dp * dp_du;
+                            j.push(dr_dm * dm_dp * dp_du);
                         }
                     }
-                    row += 1;
                 }
             }
+            (r, j, sum_rel)
+        };
+        let parts: Vec<(Vec<f64>, Vec<f64>, f64)> = if m >= PARALLEL_ROWS {
+            chunks.par_iter().map(run_chunk).collect()
+        } else {
+            chunks.iter().map(run_chunk).collect()
+        };
+        let mut residuals = DVector::zeros(m);
+        let mut jac = if JACOBIAN { DMatrix::zeros(m, n) } else { DMatrix::zeros(0, 0) };
+        let mut sum_rel = 0.0;
+        for (&(_, _, _, first), (r, j, s)) in chunks.iter().zip(&parts) {
+            residuals.as_mut_slice()[first..first + r.len()].copy_from_slice(r);
+            if JACOBIAN {
+                for (col, mut column) in jac.column_iter_mut().enumerate() {
+                    let column = &mut column.as_mut_slice()[first..first + r.len()];
+                    for (row, value) in column.iter_mut().enumerate() {
+                        *value = j[row * n + col];
+                    }
+                }
+            }
+            sum_rel += s;
         }
-        drop(jac_columns);
         self.evaluations.set(self.evaluations.get() + 1);
         let finite = residuals.iter().all(|x| x.is_finite())
             && (!JACOBIAN || jac.iter().all(|x| x.is_finite()));
@@ -179,6 +194,23 @@ impl Problem<'_> {
         })
     }
 }
+
+/// Residual for model `m` and measured `y` with factor `k`, and dr/dm.
+#[inline(always)]
+fn residual(kind: ResidualKind, floor: f64, m: f64, y: f64, k: f64) -> (f64, f64) {
+    match kind {
+        ResidualKind::Absolute | ResidualKind::Relative => (k * (m - y), k),
+        ResidualKind::Log => {
+            let a = m.max(0.0) + floor;
+            (k * (a.ln() - (y.max(0.0) + floor).ln()), k / a)
+        }
+    }
+}
+
+/// Samples per chunk of a pass.
+const CHUNK: usize = 4096;
+/// Passes with at least this many residuals run their chunks in parallel.
+const PARALLEL_ROWS: usize = 16_384;
 
 /// One pass over the data.
 pub(crate) struct Evaluation {
