@@ -11,7 +11,12 @@ pub struct AlbedoArgs {
     #[command(flatten)]
     pub material: MaterialArgs,
     /// Incident polar angles θ_in in degrees, comma-separated.
-    #[arg(long, value_delimiter = ',', required = true, allow_hyphen_values = true)]
+    #[arg(
+        long,
+        value_delimiter = ',',
+        required = true,
+        allow_hyphen_values = true
+    )]
     pub theta_in: Vec<f64>,
     /// Incident azimuth φ_in in degrees.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
@@ -31,7 +36,10 @@ pub fn run(args: AlbedoArgs) -> Result<()> {
     }
     let stdout = std::io::stdout();
     let mut out = BufWriter::new(stdout.lock());
-    writeln!(out, "theta_in,phi_in,rho_r,rho_g,rho_b,tau_r,tau_g,tau_b,rho_spike,tau_spike")?;
+    writeln!(
+        out,
+        "theta_in,phi_in,rho_r,rho_g,rho_b,tau_r,tau_g,tau_b,rho_spike,tau_spike"
+    )?;
     for &theta in &args.theta_in {
         let a = albedo(&bsdf, direction(theta, args.phi_in), args.tolerance);
         // The delta spikes are reported as their mean over the three channels.

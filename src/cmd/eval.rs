@@ -34,14 +34,19 @@ pub fn run(args: EvalArgs) -> Result<()> {
         }
         let fields: Vec<&str> = trimmed.split(',').map(str::trim).collect();
         if fields.len() != 2 {
-            bail!("<stdin>:{number}: expected `theta_out,phi_out`, found {} fields", fields.len());
+            bail!(
+                "<stdin>:{number}: expected `theta_out,phi_out`, found {} fields",
+                fields.len()
+            );
         }
         let parsed: Vec<Option<f64>> = fields.iter().map(|f| f.parse::<f64>().ok()).collect();
         let (theta, phi) = match (parsed[0], parsed[1]) {
             (Some(t), Some(p)) if t.is_finite() && p.is_finite() => (t, p),
             // A header line such as `theta_out,phi_out`.
             _ if number == 1 && parsed.iter().all(Option::is_none) => continue,
-            _ => bail!("<stdin>:{number}: `{trimmed}` is not two numbers (theta_out,phi_out in degrees)"),
+            _ => bail!(
+                "<stdin>:{number}: `{trimmed}` is not two numbers (theta_out,phi_out in degrees)"
+            ),
         };
         let f = bsdf.eval(l, direction(theta, phi));
         writeln!(out, "{},{},{},{},{}", theta, phi, f[0], f[1], f[2])?;

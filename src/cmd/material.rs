@@ -1,9 +1,7 @@
 //! Options shared by every command that evaluates a material file.
 
 use anyhow::{Context, Result};
-use brtf_model::{
-    Bsdf, EvalOptions, FRESNEL_K_CLASSIC, FRESNEL_K_PYRADIANCE, Material, Variant,
-};
+use brtf_model::{Bsdf, EvalOptions, FRESNEL_K_CLASSIC, FRESNEL_K_PYRADIANCE, Material, Variant};
 use clap::Args;
 use std::path::PathBuf;
 
@@ -51,7 +49,11 @@ impl MaterialArgs {
         let text = std::fs::read_to_string(&self.material)
             .with_context(|| format!("cannot read material file {path}"))?;
         let primitives = brtf_radiance::parse_primitives(&text, &path)?;
-        Ok(brtf_radiance::select_material(&primitives, self.name.as_deref(), &path)?)
+        Ok(brtf_radiance::select_material(
+            &primitives,
+            self.name.as_deref(),
+            &path,
+        )?)
     }
 
     pub fn options(&self) -> Result<EvalOptions> {
