@@ -1,1 +1,54 @@
-//! brtf-trace: a minimal ray tracer (being built).
+//! # brtf-trace: a minimal ray tracer that checks fitted materials
+//!
+//! A fitted material is only as good as what a renderer makes of it. This
+//! crate renders brtf-model materials the way Radiance's lighting equation
+//! (equation (1) of "Behavior of Materials in RADIANCE") prescribes, in
+//! two instruments:
+//!
+//! * the **virtual gonio-photometer** ([`gonio`]): a flat sample, a beam of
+//!   finite solid angle at (θ_in, φ_in) and a detector with an aperture at
+//!   every measured (θ_out, φ_out); it returns the rendered BSDF per
+//!   sample as a [`brtf_gonio::Measurement`];
+//! * **pictures** ([`image`]): the material on a sphere and a plane under a
+//!   source, through a pinhole camera with Radiance's view parameters,
+//!   written as Radiance HDR ([`hdr`]) and tone-mapped PNG.
+//!
+//! ## Equation (1), as traced here
+//!
+//! `R = Σ_i ∫_{Ω_i} f(q, v) L_i |q·n| dω + ∫ f_s(q, v) R(q) |q·n| dω + ∫ f_d(q, v) R(q) |q·n| dω`
+//!
+//! * the direct term samples each source uniformly over its solid angle
+//!   `Ω_i` with the whole BSDF `f` (brtf-model, evaluated for a point
+//!   source: the source's extent is integrated, not modelled by widening);
+//! * the specular part `f_s = f − f_d` is integrated with rays
+//!   importance-sampled from the Gaussian lobes ([`sampling`]); roughness-0
+//!   surfaces trace their mirror and straight-through rays;
+//! * the diffuse part `f_d` optionally gets one bounce.
+//!
+//! ## Conventions
+//!
+//! As in every brtf crate: `f(l, v)` in 1/sr **without** the cosine,
+//! local frame z = normal, `l` and `v` pointing away from the surface,
+//! two-sided materials (the surface turns towards the viewer), degrees at
+//! interfaces and radians inside. Every random number comes from a
+//! stream seeded by `(seed, pixel or direction index)`, so results are
+//! deterministic and independent of the thread count.
+
+pub mod camera;
+pub mod frame;
+pub mod gonio;
+pub mod hdr;
+pub mod image;
+pub mod integrator;
+pub mod rng;
+pub mod sampling;
+pub mod scene;
+pub mod shader;
+
+pub use camera::Camera;
+pub use gonio::{GonioSetup, GonioValue, VirtualGonio, cone_average};
+pub use image::{ImageOptions, Rendered, render};
+pub use integrator::{RayCounts, Settings, Tracer};
+pub use rng::Rng;
+pub use scene::{Ray, Scene, Shape, Source};
+pub use shader::{Shader, ShaderError};

@@ -1,0 +1,348 @@
+//! Materials as the tracer uses them: brtf-model's BSDF, split into the
+//! parts of Radiance's equation (1), and the lobes to sample.
+//!
+//! A [`Shader`] is either one material or a θ_in-dependent material from
+//! a fit's [`ParamTable`]. A table material is evaluated with the
+//! parameters at the **light's** polar angle θ_l = acos|l·n| (the
+//! incidence of the measurement it was fitted to): the table is sampled
+//! on a 0.25° grid once, and `f` is interpolated linearly between the two
+//! neighbouring grid materials.
+//!
+//! The shader always evaluates the **point** BSDF (brtf-model with source
+//! solid angle ω = 0): the tracer integrates over a source's solid angle
+//! by sampling it, which is the physical counterpart of rtrace's lobe
+//! widening `α² + ω/4π`.
+//!
+//! Equation (1) separates what comes from the sources (the direct term,
+//! with the whole `f`) from what other rays bring: the specular rays
+//! (`ρ_s R(m)`, `τ_s R(t)`) and the diffuse ambient (`ρ_a A/π`). For those
+//! the shader splits `f = f_d + f_s`: [`Shader::diffuse`] is the diffuse
+//! part `C R_d/π` (and `C T_d/π` behind), written here from the formulas
+//! of `docs/models.md` for every type and variant; `f_s = f − f_d`.
+
+use brtf_fit::{ParamTable, TableError};
+use brtf_model::{Bsdf, EvalOptions, FTINY, Material, MaterialKind, Rgb, Variant};
+use glam::DVec3;
+use std::f64::consts::PI;
+
+use crate::frame::Frame;
+use crate::sampling::{ReflectionLobe, TransmissionLobe};
+
+/// Grid step (degrees) of a θ_in-table shader.
+pub const TABLE_STEP_DEG: f64 = 0.25;
+
+/// Rtrace's Fresnel switch (FRESTHRESH).
+const FRESNEL_THRESHOLD: f64 = 0.017999;
+/// rtrace clamps the view cosine (`pdot >= .001`).
+const MIN_VIEW_COSINE: f64 = 0.001;
+
+/// What the view direction alone decides: which lobes exist and how to
+/// sample them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Lobes {
+    /// The rough reflected lobe, if the material has one.
+    pub reflect: Option<ReflectionLobe>,
+    /// The rough transmitted lobe, if any.
+    pub transmit: Option<TransmissionLobe>,
+    /// Roughness 0: mirror and straight-through delta coefficients.
+    pub delta: Option<(Rgb, Rgb)>,
+    /// A diffuse reflection part exists.
+    pub diffuse_reflect: bool,
+    /// A diffuse transmission part exists.
+    pub diffuse_transmit: bool,
+}
+
+/// One material prepared for shading.
+#[derive(Debug, Clone)]
+struct Entry {
+    /// Built with the orientation along local x.
+    bsdf: Bsdf,
+    /// Anisotropic types only: built with the orientation along the
+    /// normal (rtrace's arbitrary tangent and mean roughness).
+    degenerate: Option<Bsdf>,
+    kind: MaterialKind,
+    color: Rgb,
+    spec: f64,
+    trans: f64,
+    tspec: f64,
+    alpha2: (f64, f64),
+    pure: bool,
+    fresnel: bool,
+    variant: Variant,
+    fresnel_k: f64,
+}
+
+impl Entry {
+    fn new(material: &Material, options: &EvalOptions) -> Entry {
+        let kind = material.kind();
+        let args = material.args();
+        let along = Material::new(kind, args, Some(DVec3::X)).expect("valid material");
+        let degenerate = kind
+            .is_anisotropic()
+            .then(|| Material::new(kind, args, Some(DVec3::Z)).expect("valid material"));
+        let (trans, tspec) = match kind {
+            MaterialKind::Trans => (args[5], args[6]),
+            MaterialKind::Trans2 => (args[6], args[7]),
+            _ => (0.0, 0.0),
+        };
+        let alpha2 = if kind.is_anisotropic() {
+            (args[4] * args[4], args[5] * args[5])
+        } else {
+            (args[4] * args[4], args[4] * args[4])
+        };
+        let pure = !kind.is_anisotropic() && alpha2.0 <= FTINY;
+        Entry {
+            bsdf: Bsdf::new(&along, options),
+            degenerate: degenerate.map(|m| Bsdf::new(&m, options)),
+            kind,
+            color: material.color(),
+            spec: material.spec(),
+            trans,
+            tspec,
+            alpha2,
+            pure,
+            fresnel: options.variant == Variant::Radiance && pure && args[3] >= FRESNEL_THRESHOLD,
+            variant: options.variant,
+            fresnel_k: options.fresnel_k,
+        }
+    }
+
+    #[inline]
+    fn bsdf(&self, degenerate: bool) -> &Bsdf {
+        match (&self.degenerate, degenerate) {
+            (Some(b), true) => b,
+            _ => &self.bsdf,
+        }
+    }
+
+    #[inline]
+    fn fresnel_estimate(&self, c: f64) -> f64 {
+        (-5.85 * c).exp() - self.fresnel_k
+    }
+
+    /// Effective specularity, transmitted fraction and diffuse fraction for
+    /// a view cosine (brtf-model's view set-up).
+    #[inline]
+    fn view_split(&self, view_cosine: f64) -> (f64, f64, f64) {
+        let spec = if self.fresnel {
+            self.spec + self.fresnel_estimate(view_cosine) * (1.0 - self.spec)
+        } else if self.variant == Variant::Ward1992 && !self.kind.is_metal() {
+            self.spec + (-6.0 * view_cosine).exp() * (1.0 - self.spec)
+        } else {
+            self.spec
+        };
+        let t = self.trans * (1.0 - spec);
+        (spec, t, 1.0 - t - spec)
+    }
+
+    /// The diffuse part of `f(l, v)`, `v.z ≥ 0`.
+    fn diffuse(&self, l: DVec3, v: DVec3) -> Rgb {
+        let view_cosine = v.z.max(MIN_VIEW_COSINE);
+        let (_, t, rd) = self.view_split(view_cosine);
+        let wrong_side = if l.z < 0.0 {
+            t <= FTINY
+        } else {
+            t >= 1.0 - FTINY
+        };
+        if wrong_side {
+            return [0.0; 3];
+        }
+        let td = t - t * self.tspec;
+        let light_fresnel = if self.fresnel && (rd > FTINY || td > FTINY) {
+            1.0 - self.fresnel_estimate(l.z.abs())
+        } else {
+            1.0
+        };
+        let c = self.color;
+        if l.z > FTINY {
+            if self.kind.is_metal() && self.variant == Variant::Ward1992 {
+                let e = (-6.0 * view_cosine).exp();
+                return std::array::from_fn(|k| {
+                    let s = c[k] * self.spec + (1.0 - c[k] * self.spec) * e;
+                    c[k] * (1.0 - s) / PI
+                });
+            }
+            if rd > FTINY {
+                let k = rd * light_fresnel / PI;
+                return c.map(|x| x * k);
+            }
+        } else if l.z < -FTINY && td > FTINY {
+            let k = td * light_fresnel / PI;
+            return c.map(|x| x * k);
+        }
+        [0.0; 3]
+    }
+
+    fn lobes(&self, v: DVec3, degenerate: bool) -> Lobes {
+        let view_cosine = v.z.max(MIN_VIEW_COSINE);
+        let (spec, t, rd) = self.view_split(view_cosine);
+        let ts = t * self.tspec;
+        let (mut wu, mut wv) = self.alpha2;
+        if degenerate {
+            let mean = 0.5 * (wu + wv);
+            (wu, wv) = (mean, mean);
+        }
+        let spec_on = if self.kind.is_metal() && self.variant == Variant::Ward1992 {
+            self.spec > FTINY
+        } else {
+            spec > FTINY
+        };
+        let reflecting = t < 1.0 - FTINY;
+        let transmitting = t > FTINY;
+        Lobes {
+            reflect: (!self.pure && spec_on && reflecting).then_some(ReflectionLobe { wu, wv }),
+            transmit: (!self.pure && ts > FTINY && transmitting)
+                .then_some(TransmissionLobe { beta: wu.max(wv) }),
+            delta: self.pure.then(|| self.bsdf.delta_coefficients(view_cosine)),
+            diffuse_reflect: reflecting
+                && (rd > FTINY || (self.kind.is_metal() && self.variant == Variant::Ward1992)),
+            diffuse_transmit: transmitting && t - ts > FTINY,
+        }
+    }
+}
+
+/// Why a shader could not be built.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum ShaderError {
+    /// The fit's θ_in table gives an invalid material somewhere.
+    #[error("θ_in table: {0}")]
+    Table(#[from] TableError),
+}
+
+/// A material ready for shading: one material or a θ_in table.
+#[derive(Debug, Clone)]
+pub struct Shader {
+    entries: Vec<Entry>,
+    /// `Some(step)` for a table shader.
+    step: Option<f64>,
+    orientation: DVec3,
+    anisotropic: bool,
+    options: EvalOptions,
+}
+
+impl Shader {
+    /// One material. `options.source_omega` is ignored (set to 0): sources
+    /// are integrated by sampling.
+    pub fn new(material: &Material, options: &EvalOptions) -> Shader {
+        let options = point_options(options);
+        Shader {
+            entries: vec![Entry::new(material, &options)],
+            step: None,
+            orientation: material.orientation(),
+            anisotropic: material.kind().is_anisotropic(),
+            options,
+        }
+    }
+
+    /// A θ_in-dependent material from a fit's parameter table.
+    pub fn from_table(table: &ParamTable, options: &EvalOptions) -> Result<Shader, ShaderError> {
+        let options = point_options(options);
+        let n = (90.0 / TABLE_STEP_DEG).round() as usize;
+        let entries = (0..=n)
+            .map(|i| {
+                let lookup = table.at(i as f64 * TABLE_STEP_DEG)?;
+                Ok(Entry::new(&lookup.material, &options))
+            })
+            .collect::<Result<Vec<_>, TableError>>()?;
+        Ok(Shader {
+            entries,
+            step: Some(TABLE_STEP_DEG),
+            orientation: DVec3::from_array(table.orientation),
+            anisotropic: table.kind.is_anisotropic(),
+            options,
+        })
+    }
+
+    /// The material type.
+    pub fn kind(&self) -> MaterialKind {
+        self.entries[0].kind
+    }
+
+    /// True for a θ_in-table shader.
+    pub fn is_table(&self) -> bool {
+        self.step.is_some()
+    }
+
+    /// The evaluation options (always with ω = 0).
+    pub fn options(&self) -> &EvalOptions {
+        &self.options
+    }
+
+    /// The shading frame at a surface point with unit normal `n` already
+    /// turned towards the viewer, and whether it is rtrace's degenerate
+    /// anisotropic case (orientation along the normal).
+    #[inline]
+    pub fn frame(&self, n: DVec3) -> (Frame, bool) {
+        if self.anisotropic {
+            match Frame::from_z_and_x(n, self.orientation) {
+                Some(f) => (f, false),
+                None => (Frame::from_z(n), true),
+            }
+        } else {
+            (Frame::from_z(n), false)
+        }
+    }
+
+    /// Grid entries and weights for a light at polar cosine `cos_l`.
+    #[inline]
+    fn blend(&self, cos_l: f64) -> (usize, usize, f64) {
+        match self.step {
+            None => (0, 0, 0.0),
+            Some(step) => {
+                let theta = cos_l.abs().min(1.0).acos().to_degrees();
+                let x = (theta / step).min((self.entries.len() - 1) as f64);
+                let i = (x.floor() as usize).min(self.entries.len() - 2);
+                (i, i + 1, x - i as f64)
+            }
+        }
+    }
+
+    /// The whole BSDF `f(l, v)` (1/sr, no cosine), local frame.
+    #[inline]
+    pub fn eval(&self, l: DVec3, v: DVec3, degenerate: bool) -> Rgb {
+        let (i, j, t) = self.blend(l.z);
+        let a = self.entries[i].bsdf(degenerate).eval(l, v);
+        if t == 0.0 {
+            return a;
+        }
+        let b = self.entries[j].bsdf(degenerate).eval(l, v);
+        std::array::from_fn(|k| a[k] + t * (b[k] - a[k]))
+    }
+
+    /// The diffuse part `f_d(l, v)` of [`Self::eval`] (`v.z ≥ 0`).
+    #[inline]
+    pub fn diffuse(&self, l: DVec3, v: DVec3) -> Rgb {
+        let (i, j, t) = self.blend(l.z);
+        let a = self.entries[i].diffuse(l, v);
+        if t == 0.0 {
+            return a;
+        }
+        let b = self.entries[j].diffuse(l, v);
+        std::array::from_fn(|k| a[k] + t * (b[k] - a[k]))
+    }
+
+    /// The specular part `f − f_d` (clamped at 0 against rounding).
+    #[inline]
+    pub fn specular(&self, l: DVec3, v: DVec3, degenerate: bool) -> Rgb {
+        let f = self.eval(l, v, degenerate);
+        let d = self.diffuse(l, v);
+        std::array::from_fn(|k| (f[k] - d[k]).max(0.0))
+    }
+
+    /// The lobes to sample for view `v` (`v.z ≥ 0`). A table shader uses
+    /// the material at θ_l = θ_v, where the reflected lobe peaks.
+    #[inline]
+    pub fn lobes(&self, v: DVec3, degenerate: bool) -> Lobes {
+        let (i, j, t) = self.blend(v.z);
+        let e = if t < 0.5 { i } else { j };
+        self.entries[e].lobes(v, degenerate)
+    }
+}
+
+fn point_options(options: &EvalOptions) -> EvalOptions {
+    EvalOptions {
+        source_omega: 0.0,
+        ..*options
+    }
+}

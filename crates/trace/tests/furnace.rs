@@ -1,0 +1,84 @@
+//! White furnace: a sample in an environment of constant radiance L (no
+//! sources, no other geometry) must look like `(ρ_dh + τ_dh)·L`, with
+//! ρ_dh and τ_dh from brtf-model's `albedo` (for these reciprocal
+//! materials, the hemispherical-directional and directional-hemispherical
+//! integrals are equal). Specular lobes are importance-sampled, diffuse
+//! parts get the one-bounce rays, roughness-0 surfaces trace their deltas.
+
+use crate::common::{mat, zoo};
+use brtf_model::{Bsdf, EvalOptions, MaterialKind, albedo};
+use brtf_trace::{Ray, RayCounts, Rng, Scene, Settings, Shader, Shape, Tracer};
+use glam::DVec3;
+
+fn furnace_radiance(shader: Shader, v: DVec3, background: f64, rays: u32) -> ([f64; 3], RayCounts) {
+    let mut scene = Scene::new();
+    let id = scene.add_shader(shader);
+    scene.add(
+        Shape::Disk {
+            center: DVec3::ZERO,
+            normal: DVec3::Z,
+            radius: 1.0,
+        },
+        id,
+    );
+    scene.background = [background; 3];
+    let settings = Settings {
+        source_samples: 1,
+        specular_samples: 16,
+        diffuse_samples: 16,
+        max_depth: 2,
+    };
+    let tracer = Tracer::new(&scene, settings);
+    let mut counts = RayCounts::default();
+    let mut sum = [0.0; 3];
+    for i in 0..rays {
+        let mut rng = Rng::new(42, i as u64);
+        let r = tracer.radiance(
+            &Ray {
+                origin: v * 5.0,
+                dir: -v,
+            },
+            &mut rng,
+            &mut counts,
+        );
+        for k in 0..3 {
+            sum[k] += r[k];
+        }
+    }
+    (sum.map(|s| s / rays as f64), counts)
+}
+
+#[test]
+fn white_furnace_gives_albedo_times_radiance() {
+    use MaterialKind::*;
+    let mut materials = zoo();
+    materials.push(("pure plastic", mat(Plastic, &[0.5, 0.5, 0.5, 0.05, 0.0])));
+    materials.push((
+        "pure trans",
+        mat(Trans, &[0.8, 0.8, 0.8, 0.05, 0.0, 0.7, 0.5]),
+    ));
+    materials.push(("white lambert", mat(Plastic, &[1.0, 1.0, 1.0, 0.0, 0.0])));
+    let options = EvalOptions::default();
+    let background = 2.5;
+    let mut worst: (f64, String) = (0.0, String::new());
+    for (name, material) in materials {
+        let bsdf = Bsdf::new(&material, &options);
+        for theta in [0.0, 40.0, 70.0] {
+            let v = brtf_model::direction(theta, 25.0);
+            let a = albedo(&bsdf, v, 1e-6);
+            let (got, _) = furnace_radiance(Shader::new(&material, &options), v, background, 4096);
+            for k in 0..3 {
+                let want = (a.rho[k] + a.tau[k] + a.rho_spike[k] + a.tau_spike[k]) * background;
+                let rel = (got[k] - want).abs() / want;
+                if rel > worst.0 {
+                    worst = (rel, format!("{name} θ_v={theta} ch{k}: {got:?} vs {want}"));
+                }
+            }
+        }
+    }
+    eprintln!(
+        "white furnace: worst relative difference {:.2e} ({})",
+        worst.0, worst.1
+    );
+    assert!(worst.0 < 0.01, "{}", worst.1);
+}

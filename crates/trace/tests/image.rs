@@ -1,0 +1,136 @@
+//! Pictures: determinism, the output formats, and a sphere light with a
+//! known answer.
+
+use crate::common::mat;
+use brtf_model::{EvalOptions, MaterialKind};
+use brtf_trace::hdr;
+use brtf_trace::image::{auto_exposure, write_png};
+use brtf_trace::{Camera, ImageOptions, Scene, Settings, Shader, Shape, Source, render};
+use glam::DVec3;
+
+fn scene() -> Scene {
+    let mut scene = Scene::new();
+    let material = mat(MaterialKind::Plastic, &[0.6, 0.5, 0.4, 0.05, 0.1]);
+    let id = scene.add_shader(Shader::new(&material, &EvalOptions::default()));
+    scene.add(
+        Shape::Disk {
+            center: DVec3::ZERO,
+            normal: DVec3::Z,
+            radius: 5.0,
+        },
+        id,
+    );
+    scene.add(
+        Shape::Sphere {
+            center: DVec3::new(0.0, 0.0, 1.0),
+            radius: 1.0,
+        },
+        id,
+    );
+    scene.sources.push(Source::distant(
+        brtf_model::direction(40.0, 200.0),
+        0.5,
+        [1e5; 3],
+    ));
+    scene.background = [0.1; 3];
+    scene
+}
+
+#[test]
+fn pictures_are_deterministic_on_any_thread_count() {
+    let scene = scene();
+    let camera = Camera::look_at(
+        DVec3::new(6.0, -6.0, 4.0),
+        DVec3::new(0.0, 0.0, 0.7),
+        30.0,
+        4.0 / 3.0,
+    );
+    let options = ImageOptions {
+        width: 40,
+        height: 30,
+        samples: 2,
+        settings: Settings {
+            diffuse_samples: 1,
+            ..Settings::default()
+        },
+        ..ImageOptions::default()
+    };
+    let a = render(&scene, &camera, &options);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let b = pool.install(|| render(&scene, &camera, &options));
+    assert_eq!(a.picture, b.picture);
+    assert!(a.rays.primary == 40 * 30 * 2 && a.rays.shadow > 0 && a.rays.secondary > 0);
+    // Something is lit and nothing is negative or NaN.
+    assert!(
+        a.picture
+            .pixels
+            .iter()
+            .flatten()
+            .all(|x| x.is_finite() && *x >= 0.0)
+    );
+    assert!(a.picture.pixels.iter().any(|p| p[0] > 0.01));
+
+    let dir = tempfile::tempdir().unwrap();
+    let mut hdr_bytes = Vec::new();
+    hdr::write(&mut hdr_bytes, &a.picture, &[]).unwrap();
+    let back = hdr::read(&mut &hdr_bytes[..]).unwrap();
+    assert_eq!((back.width, back.height), (40, 30));
+    let png_path = dir.path().join("x.png");
+    write_png(
+        std::fs::File::create(&png_path).unwrap(),
+        &a.picture,
+        auto_exposure(&a.picture),
+    )
+    .unwrap();
+    let bytes = std::fs::read(&png_path).unwrap();
+    assert_eq!(&bytes[1..4], b"PNG");
+}
+
+#[test]
+fn lambertian_floor_under_a_sphere_light() {
+    // Directly below a sphere light of radius r at height d, the
+    // irradiance is E = L π (r/d)², so a Lambertian floor of reflectance ρ
+    // has radiance ρ L (r/d)².
+    let mut scene = Scene::new();
+    let rho = 0.5;
+    let material = mat(MaterialKind::Plastic, &[rho, rho, rho, 0.0, 0.0]);
+    let id = scene.add_shader(Shader::new(&material, &EvalOptions::default()));
+    scene.add(
+        Shape::Disk {
+            center: DVec3::ZERO,
+            normal: DVec3::Z,
+            radius: f64::INFINITY,
+        },
+        id,
+    );
+    let (r, d, l) = (0.5, 4.0, 100.0);
+    scene.sources.push(Source::Sphere {
+        center: DVec3::new(0.0, 0.0, d),
+        radius: r,
+        radiance: [l; 3],
+    });
+    // Look straight down from beside the light.
+    let camera = Camera::new(
+        DVec3::new(0.0, 1.0, 2.0),
+        DVec3::new(0.0, -0.5, -1.0),
+        DVec3::Y,
+        1.0,
+        1.0,
+    );
+    let options = ImageOptions {
+        width: 1,
+        height: 1,
+        samples: 4000,
+        jitter: false,
+        settings: Settings::direct_only(),
+        ..ImageOptions::default()
+    };
+    let pic = render(&scene, &camera, &options).picture;
+    let want = rho * l * (r / d) * (r / d);
+    let got = pic.pixels[0][0] as f64;
+    assert!((got - want).abs() < 0.01 * want, "{got} vs {want}");
+    let _ = auto_exposure;
+}

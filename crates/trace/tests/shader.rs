@@ -1,0 +1,161 @@
+//! The shader's split of brtf-model's BSDF into diffuse and specular parts,
+//! its frames, and θ_in-table shaders.
+
+use crate::common::{mat, zoo};
+use brtf_fit::{Interpolation, ParamTable};
+use brtf_model::{Bsdf, EvalOptions, MaterialKind, Variant};
+use brtf_trace::{Rng, Shader};
+use glam::DVec3;
+
+fn random_dir(rng: &mut Rng) -> DVec3 {
+    let [a, b] = rng.uniform2();
+    let z = 1.0 - 2.0 * a;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * std::f64::consts::PI * b;
+    DVec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+/// Materials of every type, plus pure and spec-0 ones.
+fn all_materials() -> Vec<(&'static str, brtf_model::Material)> {
+    use MaterialKind::*;
+    let mut m = zoo();
+    m.push(("pure plastic", mat(Plastic, &[0.5, 0.5, 0.5, 0.05, 0.0])));
+    m.push(("pure metal", mat(Metal, &[0.9, 0.8, 0.6, 0.9, 0.0])));
+    m.push((
+        "pure trans",
+        mat(Trans, &[0.8, 0.8, 0.8, 0.05, 0.0, 0.7, 0.5]),
+    ));
+    m.push(("lambert", mat(Plastic, &[0.7, 0.6, 0.5, 0.0, 0.2])));
+    m
+}
+
+#[test]
+fn diffuse_part_is_below_f_and_specular_vanishes_without_lobes() {
+    let mut rng = Rng::new(11, 0);
+    for variant in Variant::ALL {
+        let options = EvalOptions::with_variant(variant);
+        for (name, material) in all_materials() {
+            let shader = Shader::new(&material, &options);
+            // Ward 1992's Fresnel term gives even a spec-0 surface a lobe.
+            let pure = !material.kind().is_anisotropic() && material.args()[4] == 0.0;
+            let no_lobe = pure || (material.spec() == 0.0 && variant != Variant::Ward1992);
+            let (frame, degenerate) = shader.frame(DVec3::Z);
+            for _ in 0..2000 {
+                let l = random_dir(&mut rng);
+                let mut v = random_dir(&mut rng);
+                v.z = v.z.abs();
+                let (l, v) = (frame.to_local(l), frame.to_local(v));
+                let f = shader.eval(l, v, degenerate);
+                let d = shader.diffuse(l, v);
+                for k in 0..3 {
+                    assert!(
+                        d[k] <= f[k] * (1.0 + 1e-12) + 1e-15,
+                        "{variant} {name}: f_d {d:?} > f {f:?} at l={l} v={v}"
+                    );
+                    if no_lobe {
+                        assert!(
+                            (d[k] - f[k]).abs() <= 1e-12 * f[k].abs(),
+                            "{variant} {name}: f_d {d:?} != f {f:?}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn diffuse_part_equals_f_far_from_the_lobes() {
+    // Radiance variant: lobe values below 1e-6 are cut off, so far from a
+    // narrow lobe f is exactly the diffuse part.
+    let options = EvalOptions::default();
+    for args in [
+        [0.6, 0.5, 0.4, 0.05, 0.05, 0.0, 0.0],
+        [0.8, 0.8, 0.7, 0.04, 0.05, 0.6, 0.5],
+    ] {
+        let kind = if args[5] > 0.0 {
+            MaterialKind::Trans
+        } else {
+            MaterialKind::Plastic
+        };
+        let material = mat(kind, &args[..kind.n_args()]);
+        let shader = Shader::new(&material, &options);
+        let v = brtf_model::direction(20.0, 0.0);
+        for (t, p) in [(60.0, 0.0), (30.0, 90.0), (120.0, 0.0), (150.0, 90.0)] {
+            let l = brtf_model::direction(t, p);
+            assert_eq!(
+                shader.eval(l, v, false),
+                shader.diffuse(l, v),
+                "{kind} l=({t},{p})"
+            );
+        }
+    }
+}
+
+#[test]
+fn shading_frames_reproduce_the_model_in_the_measurement_frame() {
+    // The gonio sample: normal +z, local frame = world. The shader builds
+    // its own tangent frame from the orientation; f must not change, on
+    // either side of the surface.
+    let mut rng = Rng::new(5, 1);
+    for (name, material) in zoo() {
+        for orientation in [
+            DVec3::new(1.0, 0.3, 0.0),
+            DVec3::new(0.2, 1.0, 0.5),
+            DVec3::Z,
+        ] {
+            let material =
+                brtf_model::Material::new(material.kind(), material.args(), Some(orientation))
+                    .unwrap();
+            let options = EvalOptions::default();
+            let bsdf = Bsdf::new(&material, &options);
+            let shader = Shader::new(&material, &options);
+            for _ in 0..500 {
+                let l = random_dir(&mut rng);
+                let v = random_dir(&mut rng);
+                let n = if v.z >= 0.0 { DVec3::Z } else { -DVec3::Z };
+                let (frame, degenerate) = shader.frame(n);
+                let got = shader.eval(frame.to_local(l), frame.to_local(v), degenerate);
+                let want = bsdf.eval(l, v);
+                for k in 0..3 {
+                    assert!(
+                        (got[k] - want[k]).abs() <= 1e-9 * want[k].abs() + 1e-12,
+                        "{name} u={orientation}: {got:?} vs {want:?} at l={l} v={v}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn table_shader_uses_the_light_angle() {
+    let table = ParamTable {
+        kind: MaterialKind::Plastic,
+        orientation: [1.0, 0.0, 0.0],
+        method: Interpolation::Linear,
+        theta_in: vec![0.0, 40.0, 80.0],
+        args: vec![
+            vec![0.5, 0.5, 0.5, 0.05, 0.05],
+            vec![0.4, 0.4, 0.4, 0.10, 0.10],
+            vec![0.3, 0.3, 0.3, 0.20, 0.20],
+        ],
+    };
+    let options = EvalOptions::default();
+    let shader = Shader::from_table(&table, &options).unwrap();
+    assert!(shader.is_table());
+    let v = brtf_model::direction(25.0, 180.0);
+    for theta in [0.0, 10.0, 25.0, 40.0, 55.5, 80.0, 89.0] {
+        let l = brtf_model::direction(theta, 0.0);
+        let bsdf = Bsdf::new(&table.at(theta).unwrap().material, &options);
+        let want = bsdf.eval(l, v);
+        let got = shader.eval(l, v, false);
+        for k in 0..3 {
+            // Between grid nodes f is interpolated linearly over 0.25°.
+            assert!(
+                (got[k] - want[k]).abs() <= 2e-3 * want[k],
+                "θ_l = {theta}: {got:?} vs {want:?}"
+            );
+        }
+    }
+}
