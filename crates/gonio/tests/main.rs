@@ -14,4 +14,5 @@ mod robustness;
 mod select;
 mod solid_angle;
 mod summary;
+mod synth;
 mod write;
