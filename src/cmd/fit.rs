@@ -47,7 +47,6 @@ pub struct FitArgs {
         long,
         default_value = "1,0,0",
         value_delimiter = ',',
-        num_args = 3,
         allow_hyphen_values = true
     )]
     pub orientation: Vec<f64>,
