@@ -11,5 +11,6 @@
 mod albedo;
 mod common;
 mod eval;
+mod export;
 mod fit;
 mod rtrace;
