@@ -1,4 +1,6 @@
-//! brtf-radiance integration tests.
+//! brtf-radiance integration tests: primitives here, exports in `export`.
+
+mod export;
 
 use brtf_model::MaterialKind;
 use brtf_radiance::{

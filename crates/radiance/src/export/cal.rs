@@ -93,7 +93,11 @@ impl CalModel<'_> {
         for line in header {
             // Braces would end the comment early.
             let line = line.replace(['{', '}'], "");
-            o += &format!("  {line}\n").replace("  \n", "\n");
+            if line.is_empty() {
+                o += "\n";
+            } else {
+                o += &format!("  {line}\n");
+            }
         }
         o += "}\n\n";
         self.parameters(&mut o);
@@ -136,7 +140,9 @@ impl CalModel<'_> {
         for (p, name) in names.iter().enumerate() {
             let segs = &self.pieces.segments[p];
             *o += "\n";
-            if let Some(q) = (0..p).find(|&q| self.pieces.segments[q] == *segs) {
+            // A grey colour: green and blue repeat red.
+            let same_colour = (0..p.min(3)).find(|&q| self.pieces.segments[q] == *segs);
+            if let (true, Some(q)) = (p < 3, same_colour) {
                 let _ = writeln!(o, "p_{name}(t) : p_{}(t);", names[q]);
                 continue;
             }

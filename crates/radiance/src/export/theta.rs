@@ -147,14 +147,15 @@ pub(crate) fn build(
             "Parameters: the fitted table ({rows} incidences, theta_in {lo}-{hi} deg, {:?}),",
             table.method
         ),
-        "evaluated at theta_in = the angle between the surface normal and the direction to".into(),
-        "each light source sample (outside the measured range the end values hold).".into(),
-        format!(
-            "Function file: {cal_name}. Radiance finds it through RAYPATH: render in this folder,"
-        ),
-        "or add the folder to RAYPATH (docs/radiance.md).".into(),
-        String::new(),
     ];
+    h.extend(lines(&format!(
+        "evaluated at theta_in = the angle between the surface normal and the direction to
+each light source sample (outside the measured range the end values hold).
+Function file: {cal_name}. Radiance finds it through RAYPATH: render in this folder,
+or add the folder to RAYPATH (docs/radiance.md).
+
+"
+    )));
     let primitive = match entry {
         Entry::Lobe => {
             let radiance_type = match kind {
@@ -164,33 +165,23 @@ pub(crate) fn build(
             };
             let args = &table.args[0];
             let mut reals = vec![args[0], args[1], args[2], args[3]];
-            if let (Some(t), Some(ts)) = trans_indices(kind) {
+            let constants = if let (Some(t), Some(ts)) = trans_indices(kind) {
                 reals.extend([args[t], args[ts]]);
-            }
-            h.push(format!(
-                "Material: {radiance_type}. Only the roughness changes with theta_in, so the real"
-            ));
-            h.push(format!(
-                "arguments hold the constant colour, specularity{} and the function",
-                if kind.is_transmitting() {
-                    ", transmissivity and transmitted-specular fraction"
-                } else {
-                    ""
-                }
-            ));
-            h.push(format!(
-                "{LOBE_FUNCTION} the specular lobe at the light's theta_in ({variant} formulas)."
-            ));
-            h.push(String::new());
-            h.push("Compared with a static material:".into());
-            h.push(
-                "  - the specular lobe reflects light sources only (direct light); indirect light"
-                    .into(),
-            );
-            h.push(
-                "    reaches the material through its constant diffuse and specular fractions."
-                    .into(),
-            );
+                "colour, specularity,\ntransmissivity and transmitted-specular fraction"
+            } else {
+                "colour and\nspecularity"
+            };
+            h.extend(lines(&format!(
+                "Material: {radiance_type}. Only the roughness changes with theta_in, so the real
+arguments hold the constant {constants}, and the function {LOBE_FUNCTION} computes
+the specular lobe at the light's theta_in ({variant} formulas).
+
+What differs from a static {kind} in a rendering:
+  - the specular lobe responds to light sources only; indirect light (-ab) reaches
+    the constant diffuse and specular fractions as if they were diffuse;
+  - the lobe is not sampled: other objects do not appear in the glossy reflection
+    (or transmission);"
+            )));
             Primitive {
                 modifier: "void".into(),
                 kind: radiance_type.into(),
@@ -209,43 +200,44 @@ pub(crate) fn build(
                     names.iter().map(|s| s.to_string()).collect()
                 }
             };
-            let mut strings = Vec::new();
-            if deltas {
-                strings.extend(pick(MIRROR_VARIABLES));
+            let zero = || ["0", "0", "0"].map(String::from).to_vec();
+            let mut strings = if deltas {
+                pick(MIRROR_VARIABLES)
             } else {
-                strings.extend(["0", "0", "0"].map(String::from));
-            }
-            if deltas && kind.is_transmitting() {
-                strings.extend(pick(THROUGH_VARIABLES));
+                zero()
+            };
+            strings.extend(if deltas && kind.is_transmitting() {
+                pick(THROUGH_VARIABLES)
             } else {
-                strings.extend(["0", "0", "0"].map(String::from));
-            }
+                zero()
+            });
             strings.extend(pick(CHANNEL_FUNCTIONS));
             strings.push(cal_name.clone());
             let mut reals = Vec::with_capacity(9);
             reals.extend(rd0);
             reals.extend(rd0);
             reals.extend(td0);
-            h.push(format!(
-                "Material: BRTDfunc. Its functions compute brtf-model's {kind} BSDF ({variant} formulas)"
-            ));
-            h.push("with the parameters at the light's theta_in. The real arguments are constant diffuse".into());
-            h.push("parts: front and back reflectance, then transmittance, each the smallest over theta_in;".into());
-            h.push("the functions add the rest.".into());
+            h.extend(lines(&format!(
+                "Material: BRTDfunc. Its functions compute brtf-model's {kind} BSDF ({variant}
+formulas) with the parameters at the light's theta_in. The real arguments are
+constant diffuse parts (front and back reflectance, then transmittance), each the
+smallest over theta_in; the functions add the rest."
+            )));
             if deltas {
-                h.push("Roughness-0 incidences: the mirror (and straight-through) coefficients use the".into());
-                h.push("parameters at the view's theta, as for a mirror ray.".into());
+                h.extend(lines(
+                    "Roughness-0 incidences: the mirror (and straight-through) coefficients use the
+parameters at the view's theta, as a mirror ray would see them.",
+                ));
             }
-            h.push(String::new());
-            h.push("Compared with a static material:".into());
-            h.push("  - the specular lobe, and the theta_in-dependent part of the diffuse term, respond".into());
-            h.push(
-                "    to light sources only (direct light); indirect light (-ab) reaches only the"
-                    .into(),
-            );
-            h.push("    constant diffuse parts in the real arguments;".into());
-            h.push("  - no Monte-Carlo sampling of the specular lobe: other objects do not appear in the".into());
-            h.push("    glossy reflection (or transmission).".into());
+            h.extend(lines(&format!(
+                "
+What differs from a static {kind} in a rendering:
+  - the specular lobe and the theta_in-dependent part of the diffuse term respond
+    to light sources only; indirect light (-ab) reaches only the constant diffuse
+    parts in the real arguments;
+  - the lobe is not sampled: other objects do not appear in the glossy reflection
+    (or transmission);"
+            )));
             Primitive {
                 modifier: "void".into(),
                 kind: "BRTDfunc".into(),
@@ -257,24 +249,20 @@ pub(crate) fn build(
             }
         }
     };
-    h.push(
-        "  - the reflected lobe is widened by the source size (omega/4pi) on every surface,".into(),
-    );
-    h.push("    as rtrace does for flat ones only, and -dj does not reduce it.".into());
-    h.push(String::new());
-    h.push(
-        "Reciprocity: the parameters depend on the light's direction, so f(l, v) and f(v, l)"
-            .into(),
-    );
-    h.push("differ: light sources play the role of the gonio-photometer's lamp. Tools that".into());
-    h.push("exchange the roles (mkillum secondary sources, light traced from the eye) see".into());
-    h.push("theta_in from their own light direction.".into());
+    h.extend(lines(
+        "  - the reflected lobe is widened by the source size (omega/4pi) on every surface,
+    where rtrace widens it on flat surfaces only, and -dj does not reduce it.
+
+Reciprocity: the parameters follow the light's direction, so f(l, v) and f(v, l)
+differ. Light sources play the role of the gonio-photometer's lamp; tools that
+treat other surfaces as sources (mkillum) give theta_in from those.",
+    ));
     if variant != Variant::Radiance {
-        h.push(String::new());
-        h.push(format!(
-            "Variant {variant}: the functions evaluate the {variant} formulas that were fitted, not"
-        ));
-        h.push("what rtrace computes for a static material with the same parameters.".into());
+        h.extend(lines(&format!(
+            "
+Variant {variant}: the functions evaluate the {variant} formulas that were fitted,
+not what rtrace computes for a static {kind} with the same parameters."
+        )));
     }
     h.push(String::new());
     h.push(format!(
@@ -284,6 +272,11 @@ pub(crate) fn build(
     let mut rad = comment_block(&h);
     rad += &format_primitive(&primitive);
     Ok(Theta { rad, cal, notes })
+}
+
+/// The lines of a text block.
+fn lines(text: &str) -> Vec<String> {
+    text.lines().map(str::to_string).collect()
 }
 
 /// Every table row must be a valid material of the table's type.
