@@ -167,7 +167,7 @@ pub(crate) fn text(result: &FitResult, chosen: &Chosen, name: &str, with_theta: 
     }
     h.push(String::new());
     let thetas = sample_thetas(result, chosen);
-    let variant = report::variant_warning(material, &options, &thetas);
+    h.extend(report::variant_warning(material, &options, &thetas));
     if options.variant != Variant::Radiance {
         notes.push(format!(
             "{}: fitted with variant {}, which current rtrace does not compute (see its header)",
@@ -175,17 +175,12 @@ pub(crate) fn text(result: &FitResult, chosen: &Chosen, name: &str, with_theta: 
             options.variant
         ));
         if with_theta {
-            h.extend(variant);
             h.push(format!(
                 "The theta_in-dependent material {} evaluates the {} formulas itself.",
                 super::theta_file_name(name),
                 options.variant
             ));
-        } else {
-            h.extend(variant);
         }
-    } else {
-        h.extend(variant);
     }
     caveats.extend(report::range_caveats(material));
     caveats.extend(report::energy_caveats(material, &options));
