@@ -7,15 +7,15 @@
 use super::num::num;
 use super::static_material::comment_block;
 use brtf_fit::FitResult;
-use std::f64::consts::PI;
+use std::f64::consts::{FRAC_1_SQRT_2, PI};
 
 /// Full apex angle of the sun-like source, degrees.
 const SUN_APEX_DEG: f64 = 0.533;
-/// Sun direction (towards the sun): behind the sphere as seen from the
-/// camera, 35° high, so the floor shows the specular highlight.
-const SUN_DIRECTION: [f64; 3] = [-0.579228, 0.579228, 0.573576];
-/// Sky radiance (uniform glow), relative to the sun's irradiance π.
-const SKY_RADIANCE: f64 = 0.1;
+/// Sun direction (towards the sun): 45° high, from the camera's right, so
+/// the sphere shows the highlight over all incidence angles at once.
+const SUN_DIRECTION: [f64; 3] = [FRAC_1_SQRT_2, 0.0, FRAC_1_SQRT_2];
+/// Sky radiance (uniform glow); the sun's normal irradiance is π.
+const SKY_RADIANCE: f64 = 0.3;
 
 /// The scene text.
 pub(crate) fn text(result: &FitResult, name: &str, with_theta: bool) -> String {
@@ -31,11 +31,10 @@ pub(crate) fn text(result: &FitResult, name: &str, with_theta: bool) -> String {
             result.config.kind,
             env!("CARGO_PKG_VERSION")
         ),
-        "A unit sphere on a 10 x 10 floor, both of the material, z up; a sun 35 deg high behind"
+        "A unit sphere on a 10 x 10 floor, both of the material, z up; a sun 45 deg high from"
             .into(),
-        "the sphere (as seen from the camera) and a dim uniform sky. The material is not in this"
-            .into(),
-        "file: give oconv one of the material files first. In this folder:".into(),
+        "the camera's right and a dim uniform sky. The material is not in this file: give".into(),
+        "oconv one of the material files first. In this folder:".into(),
         String::new(),
         format!("  oconv {name}.rad {stem}.rad > {stem}.oct"),
     ];
@@ -46,7 +45,7 @@ pub(crate) fn text(result: &FitResult, name: &str, with_theta: bool) -> String {
     }
     h.extend([
         String::new(),
-        "Render (a few seconds at 512 x 512; rpict finds the .cal through RAYPATH, which".into(),
+        "Render (about a minute at 512 x 512; rpict finds the .cal through RAYPATH, which".into(),
         "includes the current folder by default):".into(),
         String::new(),
         format!("  rpict {view} -x 512 -y 512 -ab 1 -ad 1024 -as 256 -aa .1 -ps 1 {stem}.oct > {stem}.hdr"),
