@@ -300,3 +300,21 @@ fn write_exports_writes_atomically_and_reports_io_errors() {
     assert!(matches!(err, ExportError::Io { .. }), "{err}");
     assert!(err.to_string().contains("painted.rad"), "{err}");
 }
+
+#[test]
+fn free_scale_and_missing_global_fit_are_reported() {
+    let mut result = plastic();
+    result.config.free_scale = true;
+    result.global = None;
+    let export = exports(&result, &ExportOptions::default()).unwrap();
+    let text = file(&export, "painted.rad");
+    assert!(text.contains("free overall scale"), "{text}");
+    assert!(
+        text.contains("the fit of the incidence theta_in = 0 deg"),
+        "{text}"
+    );
+    assert!(file(&export, "painted-theta.rad").contains("free overall scale"));
+    let notes = export.notes.join("\n");
+    assert!(notes.contains("colour is relative"), "{notes}");
+    assert!(notes.contains("no all-incidence fit"), "{notes}");
+}

@@ -164,6 +164,17 @@ pub(crate) fn energy_caveats(material: &Material, options: &EvalOptions) -> Vec<
         .unwrap_or_default()
 }
 
+/// A fit with a free overall scale (raw detector signal) fixes the colour
+/// at 1: the exported reflectance is relative, not absolute.
+pub(crate) fn scale_caveat(result: &FitResult) -> Option<String> {
+    result.config.free_scale.then(|| {
+        "the fit had a free overall scale (raw signal of unknown scale): the colour is fixed \
+         at 1, so the absolute reflectance is unknown. Scale the colour arguments to a \
+         measured reflectance before using this material."
+            .to_string()
+    })
+}
+
 /// The fit's own warnings and a non-converged termination.
 pub(crate) fn fit_caveats(report: &FitReport) -> Vec<String> {
     let mut out: Vec<String> = report

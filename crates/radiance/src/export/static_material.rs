@@ -117,7 +117,13 @@ pub(crate) fn text(result: &FitResult, chosen: &Chosen, name: &str, with_theta: 
         .map(|t| t.range())
         .or_else(|| result.incidences.first().map(|r| (r.theta_in, r.theta_in)))
         .unwrap_or((0.0, 0.0));
-    let mut caveats = Vec::new();
+    let mut caveats: Vec<String> = report::scale_caveat(result).into_iter().collect();
+    if !caveats.is_empty() {
+        notes.push(format!(
+            "{}: the fit had a free scale, so the colour is relative (see its header)",
+            super::static_file_name(name)
+        ));
+    }
     match chosen.origin {
         Origin::Global(r) => {
             h.push(format!(
@@ -142,6 +148,13 @@ pub(crate) fn text(result: &FitResult, chosen: &Chosen, name: &str, with_theta: 
                     "these parameters reproduce the measurement at theta_in = {} deg only.",
                     r.theta_in
                 ));
+                if result.global.is_none() {
+                    notes.push(format!(
+                        "{}: no all-incidence fit, so the static material is the fit at θ_in = {}°",
+                        super::static_file_name(name),
+                        r.theta_in
+                    ));
+                }
             }
         }
         Origin::Interpolated { theta, clamped } => {

@@ -257,6 +257,10 @@ Reciprocity: the parameters follow the light's direction, so f(l, v) and f(v, l)
 differ. Light sources play the role of the gonio-photometer's lamp; tools that
 treat other surfaces as sources (mkillum) give theta_in from those.",
     ));
+    if let Some(scale) = report::scale_caveat(result) {
+        h.push(String::new());
+        h.push(format!("Caveat: {scale}"));
+    }
     if variant != Variant::Radiance {
         h.extend(lines(&format!(
             "
