@@ -90,7 +90,6 @@ impl Problem<'_> {
         Some((p, dp, material, scale))
     }
 
-
     pub(crate) fn residual_vector(&self, u: &DVector<f64>) -> Option<DVector<f64>> {
         self.evaluate::<false>(u).map(|e| e.residuals)
     }
@@ -111,8 +110,13 @@ impl Problem<'_> {
         let n = self.map.len();
         let m = self.n_residuals();
         let channels = self.channels;
-        let columns: Vec<(Target, f64)> =
-            self.map.slots.iter().zip(&dp).map(|(s, &d)| (s.target, d)).collect();
+        let columns: Vec<(Target, f64)> = self
+            .map
+            .slots
+            .iter()
+            .zip(&dp)
+            .map(|(s, &d)| (s.target, d))
+            .collect();
         // (block, first sample, end sample, first row)
         let mut chunks = Vec::new();
         let mut row = 0;
@@ -170,7 +174,11 @@ impl Problem<'_> {
             chunks.iter().map(run_chunk).collect()
         };
         let mut residuals = DVector::zeros(m);
-        let mut jac = if JACOBIAN { DMatrix::zeros(m, n) } else { DMatrix::zeros(0, 0) };
+        let mut jac = if JACOBIAN {
+            DMatrix::zeros(m, n)
+        } else {
+            DMatrix::zeros(0, 0)
+        };
         let mut sum_rel = 0.0;
         for (&(_, _, _, first), (r, j, s)) in chunks.iter().zip(&parts) {
             residuals.as_mut_slice()[first..first + r.len()].copy_from_slice(r);
