@@ -9,6 +9,8 @@
 //!   fitted variant) within 1% relative, or 2e-5 sr⁻¹ absolute for values
 //!   near 0, at every fitted incidence and between them, on both sides of
 //!   the surface (transmission for `trans`/`trans2`).
+//!   A pattern (colorfunc) on the θ_in-dependent material scales its colour
+//!   as it does for the static types.
 //! * **Validity.** oconv prints nothing for either material with the
 //!   preview scene, and rpict renders the preview without a message.
 //!
@@ -690,6 +692,37 @@ fn theta_export_matches_live_rtrace() {
             text.contains(&format!("void {expected_type} {name}\n")),
             "{name}: expected a {expected_type}:\n{text}"
         );
+    }
+    // A pattern on the material modifies its colour, as it does for the
+    // static types: the same material under a constant colorfunc.
+    const TINT: [f64; 3] = [0.5, 0.8, 1.0];
+    for name in ["plastic", "metal-grey", "trans", "metal-lobe", "trans2"] {
+        let k = names.iter().position(|n| n == name).unwrap();
+        let text = std::fs::read_to_string(scene_dir.join(&files[k])).unwrap();
+        let line = text
+            .lines()
+            .find(|l| l.starts_with("void ") && l.ends_with(&format!(" {name}")))
+            .unwrap();
+        let kind = line.split_whitespace().nth(1).unwrap();
+        let tinted = text.replace(line, &format!("{name}-tint {kind} {name}-tinted"));
+        let pattern = format!(
+            "void colorfunc {name}-tint\n4 {} {} {} .\n0\n0\n\n",
+            TINT[0], TINT[1], TINT[2]
+        );
+        std::fs::write(
+            scene_dir.join(format!("{name}-tinted.rad")),
+            pattern + &tinted,
+        )
+        .unwrap();
+        let mut result = cases[k].1.clone();
+        for row in &mut result.table.as_mut().unwrap().args {
+            for c in 0..3 {
+                row[c] *= TINT[c];
+            }
+        }
+        files.push(format!("{name}-tinted.rad"));
+        names.push(format!("{name}-tinted"));
+        cases.push((format!("{name}-tinted"), result));
     }
     let omega = cone_solid_angle(live::SOURCE_APEX_DEG);
     let mut incidences: Vec<(f64, f64)> = THETA_INCIDENCES.iter().map(|&t| (t, 0.0)).collect();

@@ -72,20 +72,6 @@ pub(crate) struct CalModel<'a> {
 }
 
 impl CalModel<'_> {
-    /// True when the three colour channels give the same function, so the
-    /// material can name one function three times (Radiance then
-    /// evaluates it once).
-    pub fn grey(&self) -> bool {
-        let s = &self.pieces.segments;
-        let same = s[0] == s[1] && s[1] == s[2];
-        match self.entry {
-            Entry::Brtd { rd0, td0, .. } => {
-                same && rd0.iter().all(|&x| x == rd0[0]) && td0.iter().all(|&x| x == td0[0])
-            }
-            Entry::Lobe => same,
-        }
-    }
-
     /// The `.cal` text. `header` lines become a leading comment.
     pub fn text(&self, header: &[String]) -> String {
         let mut o = String::new();
@@ -170,7 +156,7 @@ impl CalModel<'_> {
                 }
             }
         }
-        *o += "\ncol(k, t) : select(k, p_red(t), p_green(t), p_blue(t));\n\n";
+        *o += "\n";
     }
 
     /// Section 2: constants and helpers.
@@ -223,7 +209,9 @@ impl CalModel<'_> {
         let radiance = self.variant == Variant::Radiance;
         let ward = self.variant == Variant::Ward1992;
         let metal = self.kind.is_metal();
-        *o += "{ ===== 4. Specular, diffuse and transmitted fractions at theta_in = t ===== }\n";
+        *o += "{ ===== 4. Specular, diffuse and transmitted fractions at theta_in = t =====\n";
+        *o += "  The colour is modified by a pattern on the material, if any (CrP CgP CbP). }\n";
+        *o += "col(k, t) = select(k, p_red(t)*CrP, p_green(t)*CgP, p_blue(t)*CbP);\n";
         if self.iso() {
             *o += "pure(t) : if(sq(p_rough(t)) - ftiny, -1, 1);   { roughness <= 0.001: mirror-like }\n";
         }
@@ -396,7 +384,8 @@ impl CalModel<'_> {
         }
         *o += "\n{ ===== 7. What BRTDfunc calls =====\n";
         *o += "  The material's real arguments hold constant diffuse parts (the smallest over\n";
-        *o += "  theta_in, so they also serve indirect light); the functions add the rest. }\n";
+        *o += "  theta_in, so they also serve indirect light; Radiance applies a pattern to\n";
+        *o += "  them); the functions add the rest. }\n";
         let channel = ["red", "green", "blue"];
         for (k, name) in channel.iter().enumerate() {
             let _ = writeln!(
@@ -409,9 +398,10 @@ impl CalModel<'_> {
         for (k, name) in channel.iter().enumerate() {
             let _ = writeln!(
                 o,
-                "{}(lx, ly, lz, om) = bsdf({}, lx, ly, lz, om) - if(cosl(lx, ly, lz), rd0_{name}, td0_{name})/PI;",
+                "{}(lx, ly, lz, om) = bsdf({}, lx, ly, lz, om) - {}*if(cosl(lx, ly, lz), rd0_{name}, td0_{name})/PI;",
                 CHANNEL_FUNCTIONS[k],
-                k + 1
+                k + 1,
+                ["CrP", "CgP", "CbP"][k]
             );
         }
         if deltas {

@@ -130,7 +130,6 @@ pub(crate) fn build(
     let cal = model.text(&ch);
 
     // ---- the .rad file ----
-    let grey = model.grey();
     let mut h = vec![
         format!(
             "{}: theta_in-dependent Radiance material \"{name}\" ({kind}, variant {variant}),",
@@ -193,13 +192,7 @@ What differs from a static {kind} in a rendering:
             }
         }
         Entry::Brtd { rd0, td0, deltas } => {
-            let pick = |names: [&str; 3]| -> Vec<String> {
-                if grey {
-                    vec![names[0].to_string(); 3]
-                } else {
-                    names.iter().map(|s| s.to_string()).collect()
-                }
-            };
+            let pick = |names: [&str; 3]| names.map(String::from).to_vec();
             let zero = || ["0", "0", "0"].map(String::from).to_vec();
             let mut strings = if deltas {
                 pick(MIRROR_VARIABLES)
