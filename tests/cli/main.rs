@@ -13,4 +13,5 @@ mod common;
 mod eval;
 mod export;
 mod fit;
+mod render;
 mod rtrace;
