@@ -63,14 +63,14 @@ fn locate() -> Result<Radiance, String> {
             bin,
         });
     }
-    if let Some(path) = std::env::var_os("PATH") {
-        if let Some(bin) = std::env::split_paths(&path).find(|d| complete(d)) {
-            return Ok(Radiance {
-                lib: lib_of(&bin),
-                origin: format!("PATH ({})", bin.display()),
-                bin,
-            });
-        }
+    if let Some(path) = std::env::var_os("PATH")
+        && let Some(bin) = std::env::split_paths(&path).find(|d| complete(d))
+    {
+        return Ok(Radiance {
+            lib: lib_of(&bin),
+            origin: format!("PATH ({})", bin.display()),
+            bin,
+        });
     }
     let venv = common::repo_path(".venv/lib");
     let mut candidates: Vec<PathBuf> = std::fs::read_dir(&venv)
