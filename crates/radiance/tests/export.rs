@@ -318,3 +318,30 @@ fn free_scale_and_missing_global_fit_are_reported() {
     assert!(notes.contains("colour is relative"), "{notes}");
     assert!(notes.contains("no all-incidence fit"), "{notes}");
 }
+
+#[test]
+fn hostile_strings_stay_inside_comments() {
+    let mut result = plastic();
+    result.name = "x\ny".into();
+    result.provenance.created = "2026\nvoid light evil 0 0 3 1 1 1".into();
+    result.provenance.command_line = vec!["brtf}".into(), "{fit\r\n".into()];
+    result.provenance.inputs[0].path = "a\nb.mpc".into();
+    result.incidences[0].warnings = vec!["θ ≥ 5°\n{oops}".into()];
+    let export = exports(&result, &ExportOptions::default()).unwrap();
+    for f in &export.files {
+        assert!(f.text.is_ascii(), "{}", f.file_name);
+        if f.file_name.ends_with(".rad") {
+            let prims = parse_primitives(&f.text, &f.file_name).unwrap();
+            assert!(
+                prims.iter().all(|p| p.name != "evil"),
+                "{}:\n{}",
+                f.file_name,
+                f.text
+            );
+        } else {
+            // The .cal header is one comment: braces inside it are removed.
+            let header_end = f.text.find("\n}\n").unwrap();
+            assert!(!f.text[1..header_end].contains(['{', '}']), "{}", f.text);
+        }
+    }
+}

@@ -28,7 +28,10 @@ pub(crate) fn provenance(result: &FitResult) -> Vec<String> {
     let mut lines = vec![
         format!(
             "Fit \"{}\": {} with brtf {}, created {}.",
-            result.name, result.config.kind, p.brtf_version, p.created
+            ascii(&result.name),
+            result.config.kind,
+            ascii(&p.brtf_version),
+            ascii(&p.created)
         ),
         format!("Command: {}", ascii(&command)),
     ];
@@ -42,7 +45,7 @@ pub(crate) fn provenance(result: &FitResult) -> Vec<String> {
                 sig(f.phi_in, 4),
                 ascii(&f.quantity),
                 f.samples,
-                f.sha256.get(..16).unwrap_or(&f.sha256)
+                ascii(f.sha256.get(..16).unwrap_or(&f.sha256))
             ));
         }
     }

@@ -139,7 +139,7 @@ pub(crate) fn build(
             "written by brtf {} (brtf export) from fit \"{}\" created {}.",
             env!("CARGO_PKG_VERSION"),
             ascii(&result.name),
-            result.provenance.created
+            ascii(&result.provenance.created)
         ),
         String::new(),
         format!(
