@@ -28,7 +28,7 @@
 //!   change with θ_in and Radiance's constant arguments can carry them.
 
 use super::num::num;
-use super::pieces::Pieces;
+use super::pieces::{FALLBACK_STEP, Pieces};
 use brtf_model::{MaterialKind, Variant};
 use std::fmt::Write;
 
@@ -115,9 +115,20 @@ impl CalModel<'_> {
         let (lo, hi) = (nodes[0], nodes[nodes.len() - 1]);
         let list: Vec<String> = nodes.iter().map(|&x| num(x)).collect();
         *o += "{ ===== 1. The fitted parameters as functions of theta_in (degrees) =====\n";
-        *o += &format!("  Measured incidences: {}.\n", list.join(" "));
-        *o += "  Each segment is a cubic in s = theta_in - (segment start), exactly\n";
-        *o += "  brtf-fit's interpolation; outside the measured range the end values hold. }\n";
+        if self.pieces.exact {
+            *o += &format!("  Measured incidences: {}.\n", list.join(" "));
+            *o += "  Each segment is a cubic in s = theta_in - (segment start), exactly\n";
+            *o += "  brtf-fit's interpolation; outside the measured range the end values hold. }\n";
+        } else {
+            let _ = writeln!(
+                o,
+                "  brtf-fit's interpolation sampled every {} deg from {} to {}, straight",
+                num(FALLBACK_STEP),
+                num(lo),
+                num(hi)
+            );
+            *o += "  lines in between; outside the measured range the end values hold. }\n";
+        }
         let _ = writeln!(o, "t_lo : {};", num(lo));
         let _ = writeln!(o, "t_hi : {};", num(hi));
         *o += "t_clamp(t) : if(t - t_hi, t_hi, if(t_lo - t, t_lo, t));\n";

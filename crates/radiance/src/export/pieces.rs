@@ -21,7 +21,6 @@ pub(crate) struct Segment {
 
 impl Segment {
     /// The cubic at `theta` (degrees).
-    #[cfg(test)]
     pub fn eval(&self, theta: f64) -> f64 {
         let s = theta - self.start;
         let [a0, a1, a2, a3] = self.coef;
@@ -37,12 +36,28 @@ pub(crate) struct Pieces {
     pub nodes: Vec<f64>,
     /// `segments[param][segment]`.
     pub segments: Vec<Vec<Segment>>,
+    /// The segments are brtf-fit's own interpolation, not a resampling.
+    pub exact: bool,
 }
 
+/// Sampling step (degrees) when the table is not piecewise cubic.
+pub(crate) const FALLBACK_STEP: f64 = 0.5;
+
 impl Pieces {
-    /// Extracts the segments of `table`.
+    /// The segments of `table`: exact cubics when the table is piecewise
+    /// cubic between its nodes (checked at three more points per segment),
+    /// otherwise straight lines every [`FALLBACK_STEP`] degrees.
     pub fn of(table: &ParamTable) -> Pieces {
-        let nodes = table.theta_in.clone();
+        let exact = Pieces::cubic(table, &table.theta_in);
+        if exact.reproduces(table) {
+            exact
+        } else {
+            Pieces::dense(table)
+        }
+    }
+
+    /// One cubic per interval of `nodes`, through four samples of the table.
+    fn cubic(table: &ParamTable, nodes: &[f64]) -> Pieces {
         let n_params = table.args.first().map_or(0, Vec::len);
         let mut segments = vec![Vec::with_capacity(nodes.len().saturating_sub(1)); n_params];
         for w in nodes.windows(2) {
@@ -63,7 +78,59 @@ impl Pieces {
                 });
             }
         }
-        Pieces { nodes, segments }
+        Pieces {
+            nodes: nodes.to_vec(),
+            segments,
+            exact: true,
+        }
+    }
+
+    /// Straight lines between samples every [`FALLBACK_STEP`] degrees.
+    fn dense(table: &ParamTable) -> Pieces {
+        let (lo, hi) = table.range();
+        let n = ((hi - lo) / FALLBACK_STEP).ceil().max(1.0) as usize;
+        let nodes: Vec<f64> = (0..=n)
+            .map(|i| {
+                if i == n {
+                    hi
+                } else {
+                    lo + FALLBACK_STEP * i as f64
+                }
+            })
+            .collect();
+        let values: Vec<Vec<f64>> = nodes.iter().map(|&t| table.args_at(t).0).collect();
+        let n_params = values[0].len();
+        let segments = (0..n_params)
+            .map(|p| {
+                nodes
+                    .windows(2)
+                    .zip(values.windows(2))
+                    .map(|(x, y)| Segment {
+                        start: x[0],
+                        coef: [y[0][p], (y[1][p] - y[0][p]) / (x[1] - x[0]), 0.0, 0.0],
+                    })
+                    .collect()
+            })
+            .collect();
+        Pieces {
+            nodes,
+            segments,
+            exact: false,
+        }
+    }
+
+    /// True when the segments match the table at interior points.
+    fn reproduces(&self, table: &ParamTable) -> bool {
+        self.nodes.windows(2).enumerate().all(|(i, w)| {
+            [1.0 / 6.0, 0.5, 5.0 / 6.0].iter().all(|f| {
+                let t = w[0] + f * (w[1] - w[0]);
+                let (args, _) = table.args_at(t);
+                args.iter().enumerate().all(|(p, want)| {
+                    let got = self.segments[p][i].eval(t);
+                    (got - want).abs() <= 1e-10 * want.abs().max(1e-3)
+                })
+            })
+        })
     }
 
     /// Parameter `param` at `theta`, clamped to the table's range like
@@ -144,6 +211,21 @@ mod tests {
                         "{method:?} param {p} at {theta}: {got} vs {want}"
                     );
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn the_dense_fallback_is_close_and_the_check_accepts_exact_pieces() {
+        let t = table(Interpolation::Pchip);
+        assert!(Pieces::of(&t).exact);
+        let dense = Pieces::dense(&t);
+        assert!(!dense.exact);
+        assert_eq!(dense.nodes.len(), 141);
+        for k in 0..=700 {
+            let theta = k as f64 * 0.1;
+            for (p, want) in t.args_at(theta).0.iter().enumerate() {
+                assert!((dense.eval(p, theta) - want).abs() < 5e-5, "{p} at {theta}");
             }
         }
     }
