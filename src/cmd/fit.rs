@@ -593,7 +593,7 @@ fn summary(result: &FitResult, out: &Path) -> String {
     for n in &names {
         let _ = write!(s, " {:>17}", n);
     }
-    let _ = writeln!(s, " {:>8} {:>8}  {}", "rms_rel", "ms", "termination");
+    let _ = writeln!(s, " {:>8} {:>8}  termination", "rms_rel", "ms");
     let mut line = |label: String, r: &FitReport| {
         let _ = write!(s, "{:>8} {:>7}", label, r.n_points);
         for p in &r.params {
