@@ -77,7 +77,9 @@ fn assert_exact(result: &FitResult, truth: &[f64]) {
 
 #[test]
 fn recovers_exact_parameters_without_noise() {
-    let cases: [(&str, &str, &[f64], &[&str], &[&str]); 5] = [
+    // (model, truth material, truth arguments, synth options, fit options)
+    type Case<'a> = (&'a str, &'a str, &'a [f64], &'a [&'a str], &'a [&'a str]);
+    let cases: [Case; 5] = [
         (
             "metal",
             "void metal m 0 0 5 0.8 0.8 0.8 0.9 0.06",
