@@ -32,6 +32,8 @@ enum Command {
     Render(cmd::render::RenderArgs),
     /// Check a fit by rendering every incidence through the virtual gonio-photometer.
     Check(cmd::check::CheckArgs),
+    /// Plot residuals and parameter curves of a fit folder.
+    Plot(cmd::plot::PlotArgs),
 }
 
 fn main() {
@@ -45,6 +47,7 @@ fn main() {
         Command::Export(args) => cmd::export::run(args),
         Command::Render(args) => cmd::render::run(args),
         Command::Check(args) => cmd::check::run(args),
+        Command::Plot(args) => cmd::plot::run(args),
     };
     if let Err(err) = result {
         eprintln!("brtf: error: {err:#}");

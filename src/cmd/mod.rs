@@ -7,5 +7,6 @@ pub mod fit;
 pub mod info;
 pub mod material;
 pub mod output;
+pub mod plot;
 pub mod render;
 pub mod synth;

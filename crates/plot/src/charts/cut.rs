@@ -1,0 +1,380 @@
+//! In-plane cuts: the data and the model along the plane of incidence, on
+//! a log axis.
+//!
+//! The plane holds the incident and mirror directions (φ_in and
+//! φ_in + 180°). A direction in it is drawn at its signed angle from the
+//! front normal, `x = atan2(v·m̂, v_z)` with m̂ the horizontal unit vector
+//! towards the mirror azimuth: the mirror direction is at `+θ_in`, the
+//! light at `−θ_in`, the back hemisphere beyond ±90°. Data points are the
+//! samples within a small angle of the plane (chosen so the cut holds at
+//! least 60 fitted samples, at most 3°); the model is evaluated exactly in
+//! the plane.
+
+use super::{LABEL, SMALL, TICK, fmt, incidence_label, log_range, titled};
+use crate::colour::{self, DATA, GUIDE, MASKED, MODEL, SHADE};
+use crate::figure::{Canvas, Chart, FONT, OrMsg};
+use crate::prepare::{Incidence, PlotSample};
+use glam::DVec3;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+/// Plane tolerances tried, degrees.
+const TOLERANCES: [f64; 6] = [0.25, 0.5, 1.0, 1.5, 2.0, 3.0];
+/// Fitted samples a cut should hold.
+const ENOUGH: usize = 60;
+/// Decades shown below the top of the log axis.
+const DECADES: f64 = 6.0;
+
+/// The cut geometry of one incidence.
+pub struct Plane {
+    /// Unit vector towards the mirror azimuth, horizontal.
+    mirror_axis: DVec3,
+    /// Normal of the plane of incidence.
+    normal: DVec3,
+}
+
+impl Plane {
+    /// The plane of incidence of `inc`.
+    pub fn of(inc: &Incidence) -> Plane {
+        let phi = inc.phi_in.to_radians();
+        Plane {
+            mirror_axis: DVec3::new(-phi.cos(), -phi.sin(), 0.0),
+            normal: DVec3::new(-phi.sin(), phi.cos(), 0.0),
+        }
+    }
+
+    /// Signed in-plane angle of `v`, degrees (see the module docs).
+    pub fn x_of(&self, v: DVec3) -> f64 {
+        v.dot(self.mirror_axis).atan2(v.z).to_degrees()
+    }
+
+    /// Angle between `v` and the plane, degrees.
+    pub fn offset(&self, v: DVec3) -> f64 {
+        v.dot(self.normal).abs().clamp(0.0, 1.0).asin().to_degrees()
+    }
+
+    /// The in-plane direction at signed angle `x_deg`.
+    pub fn direction(&self, x_deg: f64) -> DVec3 {
+        let (s, c) = x_deg.to_radians().sin_cos();
+        self.mirror_axis * s + DVec3::Z * c
+    }
+}
+
+/// The samples of a cut, with the tolerance used.
+pub struct CutData<'a> {
+    /// Plane tolerance in degrees.
+    pub tolerance: f64,
+    /// `(x, sample)` for samples within the tolerance.
+    pub points: Vec<(f64, &'a PlotSample)>,
+    /// The model along the plane: `(x, value)`.
+    pub curve: Vec<(f64, f64)>,
+    /// The x range: ±90° (front only) or ±180°.
+    pub range: (f64, f64),
+}
+
+impl<'a> CutData<'a> {
+    /// Picks the samples near the plane and evaluates the model along it.
+    pub fn of(inc: &'a Incidence, tolerance: Option<f64>) -> CutData<'a> {
+        let plane = Plane::of(inc);
+        let near: Vec<(f64, f64, &PlotSample)> = inc
+            .samples
+            .iter()
+            .filter(|s| s.dir.is_finite())
+            .map(|s| (plane.offset(s.dir), plane.x_of(s.dir), s))
+            .filter(|(o, _, _)| *o <= TOLERANCES[TOLERANCES.len() - 1])
+            .collect();
+        let tolerance = tolerance.unwrap_or_else(|| {
+            TOLERANCES
+                .into_iter()
+                .find(|t| near.iter().filter(|(o, _, s)| *o <= *t && s.used()).count() >= ENOUGH)
+                .unwrap_or(TOLERANCES[TOLERANCES.len() - 1])
+        });
+        let back = inc.samples.iter().any(|s| s.used() && s.dir.z < 0.0);
+        let range = if back { (-180.0, 180.0) } else { (-90.0, 90.0) };
+        let points: Vec<(f64, &PlotSample)> = near
+            .into_iter()
+            .filter(|(o, x, _)| *o <= tolerance && (range.0..=range.1).contains(x))
+            .map(|(_, x, s)| (x, s))
+            .collect();
+        let steps = if back { 2880 } else { 1440 };
+        let curve = (0..=steps)
+            .map(|k| {
+                let x = range.0 + (range.1 - range.0) * k as f64 / steps as f64;
+                (x, inc.model_at(plane.direction(x)))
+            })
+            .collect();
+        CutData {
+            tolerance,
+            points,
+            curve,
+            range,
+        }
+    }
+
+    /// x intervals that the selections removed from the fit.
+    pub fn masked_ranges(&self, inc: &Incidence) -> Vec<(f64, f64)> {
+        let mut ranges = Vec::new();
+        if let Some(m) = inc.beam_mask() {
+            ranges.push((-inc.theta_in - m, -inc.theta_in + m));
+        }
+        if let Some(cap) = inc.theta_cap().filter(|c| *c < 90.0) {
+            if self.range.1 > 90.0 {
+                ranges.push((cap, 180.0 - cap));
+                ranges.push((-180.0 + cap, -cap));
+            } else {
+                ranges.push((cap, 90.0));
+                ranges.push((-90.0, -cap));
+            }
+        }
+        ranges
+            .into_iter()
+            .map(|(a, b)| (a.max(self.range.0), b.min(self.range.1)))
+            .filter(|(a, b)| b > a)
+            .collect()
+    }
+}
+
+/// The in-plane cut of one incidence.
+pub struct CutChart<'a> {
+    /// The incidence.
+    pub inc: &'a Incidence,
+    /// Chart title.
+    pub title: String,
+    /// Forced plane tolerance, degrees.
+    pub tolerance: Option<f64>,
+}
+
+impl Chart for CutChart<'_> {
+    fn name(&self) -> String {
+        format!("cut-{}", self.inc.tag)
+    }
+
+    fn size(&self) -> (u32, u32) {
+        (1000, 640)
+    }
+
+    fn draw<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+        _canvas: &Canvas,
+    ) -> Result<(), String> {
+        let inc = self.inc;
+        let cut = CutData::of(inc, self.tolerance);
+        let positive = |v: f64| v.is_finite() && v > 0.0;
+        let (lo, hi) = log_range(
+            cut.points
+                .iter()
+                .map(|(_, s)| s.data)
+                .chain(cut.curve.iter().map(|(_, m)| *m)),
+            DECADES,
+        );
+        let area = titled(root, &self.title)?;
+        let mut chart = ChartBuilder::on(&area)
+            .margin(14)
+            .margin_right(28)
+            .x_label_area_size(52)
+            .y_label_area_size(84)
+            .build_cartesian_2d(cut.range.0..cut.range.1, (lo..hi).log_scale())
+            .msg()?;
+        chart
+            .configure_mesh()
+            .x_desc("θ_out in the plane of incidence [°]  (− towards the light, + mirror side)")
+            .y_desc(inc.unit.axis())
+            .x_labels(13)
+            .x_label_formatter(&|x| fmt(*x))
+            .y_label_formatter(&|y| fmt(*y))
+            .axis_desc_style((FONT, LABEL))
+            .label_style((FONT, TICK))
+            .bold_line_style(RGBColor(226, 226, 226))
+            .light_line_style(TRANSPARENT)
+            .draw()
+            .msg()?;
+
+        let masked = cut.masked_ranges(inc);
+        if !masked.is_empty() {
+            chart
+                .draw_series(
+                    masked
+                        .iter()
+                        .map(|&(a, b)| Rectangle::new([(a, lo), (b, hi)], SHADE.filled())),
+                )
+                .msg()?
+                .label("masked range (not fitted)")
+                .legend(|(x, y)| Rectangle::new([(x, y - 6), (x + 20, y + 6)], SHADE.filled()));
+        }
+        for (x, name) in [(inc.theta_in, "mirror"), (-inc.theta_in, "light")] {
+            chart
+                .draw_series(DashedLineSeries::new(
+                    vec![(x, lo), (x, hi)],
+                    5,
+                    4,
+                    GUIDE.stroke_width(1),
+                ))
+                .msg()?;
+            chart
+                .plotting_area()
+                .draw(&Text::new(
+                    name.to_string(),
+                    (x + 1.0, hi / 1.25),
+                    (FONT, SMALL).into_font().color(&GUIDE),
+                ))
+                .msg()?;
+        }
+        let not_shown = cut
+            .points
+            .iter()
+            .filter(|(_, s)| s.used() && !positive(s.data))
+            .count();
+        let masked_points: Vec<(f64, f64)> = cut
+            .points
+            .iter()
+            .filter(|(_, s)| !s.used() && positive(s.data))
+            .map(|(x, s)| (*x, s.data))
+            .collect();
+        if !masked_points.is_empty() {
+            chart
+                .draw_series(
+                    masked_points
+                        .iter()
+                        .map(|&p| Circle::new(p, 3, MASKED.stroke_width(1))),
+                )
+                .msg()?
+                .label("data, not fitted")
+                .legend(|(x, y)| Circle::new((x + 10, y), 3, MASKED.stroke_width(1)));
+        }
+        let mut label = format!(
+            "data, fitted (within ±{}° of the plane)",
+            crate::prepare::num(cut.tolerance)
+        );
+        if not_shown > 0 {
+            label.push_str(&format!("; {not_shown} values ≤ 0 not shown"));
+        }
+        chart
+            .draw_series(
+                cut.points
+                    .iter()
+                    .filter(|(_, s)| s.used() && positive(s.data))
+                    .map(|(x, s)| Circle::new((*x, s.data), 2, DATA.filled())),
+            )
+            .msg()?
+            .label(label)
+            .legend(|(x, y)| Circle::new((x + 10, y), 3, DATA.filled()));
+        let model_label = if inc.scale != 1.0 {
+            format!("model: {} × f (fitted free scale)", fmt(inc.scale))
+        } else {
+            "model f".to_string()
+        };
+        chart
+            .draw_series(LineSeries::new(
+                cut.curve.iter().map(|&(x, m)| (x, m.max(lo))),
+                MODEL.stroke_width(2),
+            ))
+            .msg()?
+            .label(model_label)
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], MODEL.stroke_width(2)));
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .background_style(WHITE.mix(0.9))
+            .border_style(BLACK)
+            .label_font((FONT, SMALL))
+            .draw()
+            .msg()
+    }
+}
+
+/// Every incidence's cut in one chart, one colour per incidence.
+pub struct CutsChart<'a> {
+    /// The incidences with data.
+    pub incs: Vec<&'a Incidence>,
+    /// Chart title.
+    pub title: String,
+    /// Forced plane tolerance, degrees.
+    pub tolerance: Option<f64>,
+}
+
+impl Chart for CutsChart<'_> {
+    fn name(&self) -> String {
+        "cuts".into()
+    }
+
+    fn size(&self) -> (u32, u32) {
+        (1000, 640)
+    }
+
+    fn draw<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+        _canvas: &Canvas,
+    ) -> Result<(), String> {
+        let cuts: Vec<CutData> = self
+            .incs
+            .iter()
+            .map(|i| CutData::of(i, self.tolerance))
+            .collect();
+        let range = cuts.iter().fold((-90.0f64, 90.0f64), |(a, b), c| {
+            (a.min(c.range.0), b.max(c.range.1))
+        });
+        let (lo, hi) = log_range(
+            cuts.iter().flat_map(|c| {
+                c.points
+                    .iter()
+                    .filter(|(_, s)| s.used())
+                    .map(|(_, s)| s.data)
+                    .chain(c.curve.iter().map(|(_, m)| *m))
+            }),
+            DECADES,
+        );
+        let area = titled(root, &self.title)?;
+        let mut chart = ChartBuilder::on(&area)
+            .margin(14)
+            .margin_right(28)
+            .x_label_area_size(52)
+            .y_label_area_size(84)
+            .build_cartesian_2d(range.0..range.1, (lo..hi).log_scale())
+            .msg()?;
+        let unit = self.incs.first().map(|i| i.unit.axis()).unwrap_or_default();
+        chart
+            .configure_mesh()
+            .x_desc("θ_out in the plane of incidence [°]  (− towards the light, + mirror side)")
+            .y_desc(unit)
+            .x_labels(13)
+            .x_label_formatter(&|x| fmt(*x))
+            .y_label_formatter(&|y| fmt(*y))
+            .axis_desc_style((FONT, LABEL))
+            .label_style((FONT, TICK))
+            .bold_line_style(RGBColor(226, 226, 226))
+            .light_line_style(TRANSPARENT)
+            .draw()
+            .msg()?;
+        for (k, (inc, cut)) in self.incs.iter().zip(&cuts).enumerate() {
+            let c = colour::series(k);
+            chart
+                .draw_series(
+                    cut.points
+                        .iter()
+                        .filter(|(_, s)| s.used() && s.data > 0.0)
+                        .map(|(x, s)| Circle::new((*x, s.data), 2, c.mix(0.55).filled())),
+                )
+                .msg()?;
+            chart
+                .draw_series(LineSeries::new(
+                    cut.curve.iter().map(|&(x, m)| (x, m.max(lo))),
+                    c.stroke_width(2),
+                ))
+                .msg()?
+                .label(incidence_label(inc.theta_in, inc.phi_in))
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2))
+                });
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .background_style(WHITE.mix(0.9))
+            .border_style(BLACK)
+            .label_font((FONT, SMALL))
+            .draw()
+            .msg()
+    }
+}

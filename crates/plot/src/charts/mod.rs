@@ -1,0 +1,182 @@
+//! The charts, one module per kind, and the styling they share.
+//!
+//! * [`map`]: per incidence, model ÷ data over the hemisphere.
+//! * [`cut`]: per incidence, the in-plane cut; and all cuts in one chart.
+//! * [`theta`]: over θ_in, the parameters, ρ_dh and the RMS error.
+
+pub mod cut;
+pub mod map;
+pub mod theta;
+
+use crate::figure::{FONT, OrMsg};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+
+/// Font sizes in pixels.
+pub const TITLE: f64 = 22.0;
+pub const LABEL: f64 = 17.0;
+pub const TICK: f64 = 14.0;
+pub const SMALL: f64 = 13.0;
+
+/// A text style of `size` pixels in `colour`, anchored at `h`, `v`.
+pub fn text(size: f64, colour: &RGBColor, h: HPos, v: VPos) -> TextStyle<'static> {
+    (FONT, size).into_font().color(colour).pos(Pos::new(h, v))
+}
+
+/// Plain black text anchored at its left and vertical centre.
+pub fn left(size: f64) -> TextStyle<'static> {
+    text(size, &BLACK, HPos::Left, VPos::Center)
+}
+
+/// Draws the chart's title centred at the top and returns the area below.
+pub fn titled<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    title: &str,
+) -> Result<DrawingArea<DB, Shift>, String> {
+    root.titled(title, (FONT, TITLE).into_font().color(&BLACK))
+        .msg()
+}
+
+/// A tick label: integers as such, otherwise up to three significant
+/// digits, with an exponent outside [1e-3, 1e4).
+pub fn fmt(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let a = v.abs();
+    if !(1e-3..1e4).contains(&a) {
+        let s = format!("{v:.1e}");
+        return s.replace(".0e", "e");
+    }
+    if (v - v.round()).abs() < 1e-9 * a.max(1.0) {
+        return format!("{}", v.round() as i64);
+    }
+    let digits = (2 - a.log10().floor() as i32).clamp(0, 6) as usize;
+    let s = format!("{v:.digits$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+/// A tick formatter for a linear axis over `[lo, hi]`: as many decimals
+/// as the tick spacing needs, trailing zeros trimmed; an exponent for very
+/// large or very small magnitudes.
+pub fn lin_fmt(lo: f64, hi: f64) -> impl Fn(&f64) -> String {
+    let step = ((hi - lo).abs() / 10.0).max(1e-300);
+    let big = lo.abs().max(hi.abs());
+    let decimals = (-step.log10()).ceil().max(0.0) as usize + 1;
+    move |v: &f64| {
+        if *v == 0.0 {
+            return "0".into();
+        }
+        if !(1e-3..1e5).contains(&big) {
+            return format!("{v:.2e}").replace(".00e", "e");
+        }
+        let s = format!("{v:.decimals$}");
+        if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            s
+        }
+    }
+}
+
+/// Range `[lo, hi]` of a log axis that shows every positive value in
+/// `values`, with a margin, and at most `decades` decades below the top.
+pub fn log_range(values: impl Iterator<Item = f64>, decades: f64) -> (f64, f64) {
+    let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+    for v in values.filter(|v| v.is_finite() && *v > 0.0) {
+        lo = lo.min(v);
+        hi = hi.max(v);
+    }
+    if hi <= 0.0 {
+        return (0.1, 10.0);
+    }
+    let hi = hi * 2.0;
+    let lo = (lo * 0.5).max(hi * 10f64.powf(-decades));
+    if hi / lo < 10.0 {
+        (hi / 10.0, hi)
+    } else {
+        (lo, hi)
+    }
+}
+
+/// Range of a linear axis over `values` with 8% margins (never empty).
+pub fn lin_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for v in values.filter(|v| v.is_finite()) {
+        lo = lo.min(v);
+        hi = hi.max(v);
+    }
+    if !lo.is_finite() {
+        return (0.0, 1.0);
+    }
+    let span = hi - lo;
+    let pad = if span > 1e-12 * hi.abs().max(lo.abs()) {
+        0.08 * span
+    } else {
+        0.05 * hi.abs().max(1e-3)
+    };
+    (lo - pad, hi + pad)
+}
+
+/// The θ_in axis range over `thetas` (at least 10° wide).
+pub fn theta_range(thetas: &[f64]) -> (f64, f64) {
+    let lo = thetas.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = thetas.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if !lo.is_finite() {
+        return (0.0, 90.0);
+    }
+    let pad = (0.06 * (hi - lo)).max(5.0);
+    (lo - pad, hi + pad)
+}
+
+/// `θ_in = 30°` (φ_in appended when not 0).
+pub fn incidence_label(theta_in: f64, phi_in: f64) -> String {
+    if phi_in == 0.0 {
+        format!("θ_in = {}°", crate::prepare::num(theta_in))
+    } else {
+        format!(
+            "θ_in = {}°, φ_in = {}°",
+            crate::prepare::num(theta_in),
+            crate::prepare::num(phi_in)
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tick_labels_are_short() {
+        assert_eq!(fmt(100.0), "100");
+        assert_eq!(fmt(0.5), "0.5");
+        assert_eq!(fmt(0.123456), "0.123");
+        assert_eq!(fmt(1.2345), "1.23");
+        assert_eq!(fmt(1e-5), "1e-5");
+        assert_eq!(fmt(2.5e5), "2.5e5");
+    }
+
+    #[test]
+    fn linear_labels_resolve_the_ticks() {
+        let f = lin_fmt(0.1527, 0.1538);
+        assert_ne!(f(&0.1530), f(&0.1531));
+        assert_eq!(f(&0.1530), "0.153");
+        assert_eq!(f(&0.1531), "0.1531");
+        let f = lin_fmt(0.0, 60.0);
+        assert_eq!(f(&20.0), "20");
+    }
+
+    #[test]
+    fn log_range_spans_a_decade_at_least() {
+        let (lo, hi) = log_range([1.0, 2.0].into_iter(), 6.0);
+        assert!(hi / lo >= 10.0 - 1e-9);
+        let (lo, hi) = log_range([1e-9, 1.0].into_iter(), 4.0);
+        assert!((hi / lo - 1e4).abs() < 1e-6);
+        assert_eq!(log_range([0.0, -1.0].into_iter(), 3.0), (0.1, 10.0));
+    }
+}

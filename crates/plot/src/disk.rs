@@ -1,0 +1,288 @@
+//! The hemisphere as a disk: Lambert's azimuthal equal-area projection
+//! and the nearest-sample raster of the residual maps.
+//!
+//! A direction at angle θ' from the hemisphere's normal and azimuth φ maps
+//! to `r = 2 sin(θ'/2)`, `(x, y) = r (cos φ, sin φ)`: the hemisphere becomes
+//! the disk of radius √2 and every region keeps its area, so a patch of the
+//! map is as large as the solid angle it covers (the same projection
+//! brtf-gonio uses for its solid angles). φ = 0 points right, φ = 90° up.
+//! The back hemisphere is projected about the back normal with the same φ
+//! (seen through the sample from the front).
+//!
+//! The raster colours every pixel by its nearest sample, as long as that
+//! sample is no farther than its own distance to its nearest neighbour or
+//! a minimum reach, whichever is larger (the maps use 2.5°): the map shows
+//! the measured layout, and gaps wider than twice that stay white.
+
+use brtf_gonio::Hemisphere;
+use glam::DVec3;
+use rayon::prelude::*;
+use std::sync::OnceLock;
+
+/// Radius of the projected hemisphere.
+pub const RADIUS: f64 = std::f64::consts::SQRT_2;
+
+/// Projects unit direction `v` about the normal of `hemisphere`.
+pub fn project(v: DVec3, hemisphere: Hemisphere) -> (f64, f64) {
+    let c = match hemisphere {
+        Hemisphere::Front => v.z,
+        Hemisphere::Back => -v.z,
+    };
+    let s = v.x.hypot(v.y);
+    let r = (2.0 * (1.0 - c)).max(0.0).sqrt();
+    if s < 1e-12 {
+        (0.0, 0.0)
+    } else {
+        (v.x * r / s, v.y * r / s)
+    }
+}
+
+/// Projected radius of polar angle `theta_deg` from the normal.
+pub fn radius_of(theta_deg: f64) -> f64 {
+    2.0 * (0.5 * theta_deg.to_radians()).sin()
+}
+
+/// Points on the rim of the cone of half-angle `half_deg` about `axis`,
+/// projected, split where the cone leaves the hemisphere.
+pub fn cone_outline(axis: DVec3, half_deg: f64, hemisphere: Hemisphere) -> Vec<Vec<(f64, f64)>> {
+    let axis = axis.normalize();
+    let helper = if axis.z.abs() < 0.9 {
+        DVec3::Z
+    } else {
+        DVec3::X
+    };
+    let e1 = axis.cross(helper).normalize();
+    let e2 = axis.cross(e1);
+    let (s, c) = half_deg.to_radians().sin_cos();
+    let mut runs = Vec::new();
+    let mut run = Vec::new();
+    for k in 0..=180 {
+        let a = k as f64 * std::f64::consts::TAU / 180.0;
+        let v = axis * c + (e1 * a.cos() + e2 * a.sin()) * s;
+        let inside = match hemisphere {
+            Hemisphere::Front => v.z >= 0.0,
+            Hemisphere::Back => v.z < 0.0,
+        };
+        if inside {
+            run.push(project(v, hemisphere));
+        } else if !run.is_empty() {
+            runs.push(std::mem::take(&mut run));
+        }
+    }
+    if !run.is_empty() {
+        runs.push(run);
+    }
+    runs
+}
+
+/// A uniform bucket grid over the projected disk for nearest-point queries.
+struct Grid {
+    cell: f64,
+    n: usize,
+    start: Vec<u32>,
+    items: Vec<u32>,
+    points: Vec<(f64, f64)>,
+}
+
+impl Grid {
+    fn new(points: Vec<(f64, f64)>, cell: f64) -> Grid {
+        let n = ((2.0 * RADIUS / cell).ceil() as usize).clamp(1, 2048);
+        let cell = 2.0 * RADIUS / n as f64;
+        let mut counts = vec![0u32; n * n + 1];
+        let index: Vec<usize> = points
+            .iter()
+            .map(|&(x, y)| Self::cell_of(x, y, cell, n))
+            .collect();
+        for &i in &index {
+            counts[i + 1] += 1;
+        }
+        for i in 0..n * n {
+            counts[i + 1] += counts[i];
+        }
+        let mut fill = counts.clone();
+        let mut items = vec![0u32; points.len()];
+        for (p, &i) in index.iter().enumerate() {
+            items[fill[i] as usize] = p as u32;
+            fill[i] += 1;
+        }
+        Grid {
+            cell,
+            n,
+            start: counts,
+            items,
+            points,
+        }
+    }
+
+    fn cell_of(x: f64, y: f64, cell: f64, n: usize) -> usize {
+        let ix = (((x + RADIUS) / cell) as isize).clamp(0, n as isize - 1) as usize;
+        let iy = (((y + RADIUS) / cell) as isize).clamp(0, n as isize - 1) as usize;
+        iy * n + ix
+    }
+
+    /// Nearest point to (x, y) other than `skip`, within `max_dist`.
+    fn nearest(&self, x: f64, y: f64, max_dist: f64, skip: Option<usize>) -> Option<(usize, f64)> {
+        let n = self.n as isize;
+        let cx = (((x + RADIUS) / self.cell) as isize).clamp(0, n - 1);
+        let cy = (((y + RADIUS) / self.cell) as isize).clamp(0, n - 1);
+        let mut best: Option<(usize, f64)> = None;
+        let max_ring = (max_dist / self.cell).ceil() as isize + 1;
+        for ring in 0..=max_ring.min(n) {
+            let mut visit = |ix: isize, iy: isize| {
+                if ix < 0 || iy < 0 || ix >= n || iy >= n {
+                    return;
+                }
+                let c = (iy * n + ix) as usize;
+                for &p in &self.items[self.start[c] as usize..self.start[c + 1] as usize] {
+                    let p = p as usize;
+                    if Some(p) == skip {
+                        continue;
+                    }
+                    let (px, py) = self.points[p];
+                    let d2 = (px - x) * (px - x) + (py - y) * (py - y);
+                    if best.is_none_or(|(_, b)| d2 < b) {
+                        best = Some((p, d2));
+                    }
+                }
+            };
+            if ring == 0 {
+                visit(cx, cy);
+            } else {
+                for ix in cx - ring..=cx + ring {
+                    visit(ix, cy - ring);
+                    visit(ix, cy + ring);
+                }
+                for iy in cy - ring + 1..cy + ring {
+                    visit(cx - ring, iy);
+                    visit(cx + ring, iy);
+                }
+            }
+            // Every point in ring + 1 is at least `ring × cell` away.
+            if let Some((_, b)) = best
+                && b.sqrt() <= ring as f64 * self.cell
+            {
+                break;
+            }
+        }
+        best.map(|(p, d2)| (p, d2.sqrt()))
+            .filter(|&(_, d)| d <= max_dist)
+    }
+}
+
+/// Colours a `size × size` raster of the disk (pixel centres span
+/// [−RADIUS, RADIUS], y up): each pixel takes `colour(k)` of its nearest
+/// projected point `k` if that point is within its reach: its distance to
+/// its own nearest neighbour, but at least `min_reach` (projected units)
+/// and one pixel. Other pixels stay transparent.
+pub fn nearest_raster(
+    points: &[(f64, f64)],
+    size: u32,
+    min_reach: f64,
+    colour: impl Fn(usize) -> [u8; 3] + Sync,
+) -> Vec<u8> {
+    let mut rgba = vec![0u8; (size * size * 4) as usize];
+    if points.is_empty() || size == 0 {
+        return rgba;
+    }
+    let pixel = 2.0 * RADIUS / size as f64;
+    let min_reach = min_reach.max(pixel);
+    // Typical spacing: the mean area per point.
+    let spacing = (std::f64::consts::PI * RADIUS * RADIUS / points.len() as f64).sqrt();
+    let grid = Grid::new(points.to_vec(), spacing.max(0.25 * min_reach));
+    // Isolated samples reach at most a few typical spacings, which also
+    // bounds the search of pixels in gaps.
+    let far = (4.0 * spacing).max(min_reach);
+    // A sample's own nearest-neighbour distance is only needed when a pixel
+    // lies beyond the minimum reach: found then, and remembered.
+    let reach: Vec<OnceLock<f64>> = (0..points.len()).map(|_| OnceLock::new()).collect();
+    let reach_of = |k: usize| {
+        *reach[k].get_or_init(|| {
+            grid.nearest(points[k].0, points[k].1, far, Some(k))
+                .map_or(far, |(_, d)| d)
+                .max(min_reach)
+        })
+    };
+    let rim2 = (RADIUS + 0.5 * pixel) * (RADIUS + 0.5 * pixel);
+    rgba.par_chunks_mut((size * 4) as usize)
+        .enumerate()
+        .for_each(|(j, row)| {
+            let y = RADIUS - (j as f64 + 0.5) * pixel;
+            for i in 0..size as usize {
+                let x = -RADIUS + (i as f64 + 0.5) * pixel;
+                if x * x + y * y > rim2 {
+                    continue;
+                }
+                if let Some((k, d)) = grid.nearest(x, y, far, None)
+                    && (d <= min_reach || d <= reach_of(k))
+                {
+                    let c = colour(k);
+                    row[4 * i..4 * i + 3].copy_from_slice(&c);
+                    row[4 * i + 3] = 255;
+                }
+            }
+        });
+    rgba
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn projection_keeps_the_rim_and_the_azimuth() {
+        let (x, y) = project(DVec3::new(1.0, 0.0, 0.0), Hemisphere::Front);
+        assert!((x - RADIUS).abs() < 1e-12 && y.abs() < 1e-12);
+        let (x, y) = project(DVec3::new(0.0, 0.0, 1.0), Hemisphere::Front);
+        assert_eq!((x, y), (0.0, 0.0));
+        let v = brtf_model::direction(60.0, 90.0);
+        let (x, y) = project(v, Hemisphere::Front);
+        assert!(x.abs() < 1e-12 && (y - radius_of(60.0)).abs() < 1e-12);
+        let (x, _) = project(brtf_model::direction(150.0, 0.0), Hemisphere::Back);
+        assert!((x - radius_of(30.0)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn raster_fills_near_points_and_leaves_gaps() {
+        // A regular grid of points on the left half only.
+        let mut pts = Vec::new();
+        for i in 0..40 {
+            for j in 0..80 {
+                let x = -RADIUS + (i as f64 + 0.5) * RADIUS / 40.0;
+                let y = -RADIUS + (j as f64 + 0.5) * 2.0 * RADIUS / 80.0;
+                if x * x + y * y < RADIUS * RADIUS {
+                    pts.push((x, y));
+                }
+            }
+        }
+        let size = 100;
+        let rgba = nearest_raster(&pts, size, 0.0, |_| [10, 20, 30]);
+        let alpha = |i: u32, j: u32| rgba[((j * size + i) * 4 + 3) as usize];
+        assert_eq!(alpha(25, 50), 255, "left half is covered");
+        assert_eq!(alpha(80, 50), 0, "right half is a gap");
+        assert_eq!(alpha(0, 0), 0, "corner is outside the disk");
+    }
+
+    #[test]
+    fn nearest_matches_brute_force() {
+        let pts: Vec<(f64, f64)> = (0..500)
+            .map(|k| {
+                let a = k as f64 * 2.399963;
+                let r = RADIUS * ((k as f64 + 0.5) / 500.0).sqrt();
+                (r * a.cos(), r * a.sin())
+            })
+            .collect();
+        let grid = Grid::new(pts.clone(), 0.05);
+        for q in 0..200 {
+            let (x, y) = (
+                -1.3 + 2.6 * ((q * 37) % 200) as f64 / 200.0,
+                -1.3 + 2.6 * q as f64 / 200.0,
+            );
+            let brute = pts
+                .iter()
+                .map(|&(px, py)| ((px - x).powi(2) + (py - y).powi(2)).sqrt())
+                .fold(f64::INFINITY, f64::min);
+            let (_, d) = grid.nearest(x, y, 10.0, None).unwrap();
+            assert!((d - brute).abs() < 1e-12, "{q}: {d} vs {brute}");
+        }
+    }
+}

@@ -1,0 +1,310 @@
+//! Rendering one chart to SVG and PNG, with the embedded font, and writing
+//! files atomically.
+//!
+//! This module owns the plotters backends. A [`Chart`] draws itself on any
+//! backend; [`write_chart`] renders it twice (SVG text, PNG pixels) and
+//! writes `<name>.svg` and `<name>.png`.
+//!
+//! * **Fonts.** plotters is built without its system-font feature: the
+//!   DejaVu Sans faces embedded by the `dejavu` crate are registered for the
+//!   `sans-serif` family before anything is drawn ([`register_fonts`]), so
+//!   charts render on a machine without fontconfig or any font installed.
+//!   SVG files keep text as `<text>` elements for the viewer's own fonts.
+//! * **Rasters.** Dense images (the residual maps) are drawn pixel by pixel
+//!   into PNGs, and embedded once as a base64 PNG `<image>` into SVGs (an
+//!   SVG rectangle per pixel would be megabytes): the chart draws a
+//!   placeholder rectangle in a reserved colour, which is then replaced.
+
+use crate::error::PlotError;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::cell::RefCell;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+/// The font family every chart uses.
+pub const FONT: &str = "sans-serif";
+
+/// Registers the embedded DejaVu Sans faces (once per process).
+pub fn register_fonts() {
+    static DONE: OnceLock<()> = OnceLock::new();
+    DONE.get_or_init(|| {
+        // Both faces are valid TrueType files shipped inside the binary.
+        let _ = plotters::style::register_font(FONT, FontStyle::Normal, dejavu::sans::regular());
+        let _ = plotters::style::register_font(FONT, FontStyle::Bold, dejavu::sans::bold());
+    });
+}
+
+/// Which backend a chart is being drawn on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Mode {
+    /// SVG text.
+    Svg,
+    /// PNG pixels.
+    Png,
+}
+
+/// An RGBA image to place on a chart.
+#[derive(Debug, Clone)]
+pub struct Raster {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Row-major RGBA bytes; alpha 0 leaves the chart visible.
+    pub rgba: Vec<u8>,
+}
+
+/// Drawing context: the backend kind and the rasters waiting to be
+/// embedded into an SVG.
+pub struct Canvas {
+    mode: Mode,
+    pending: RefCell<Vec<(u8, (i32, i32), Raster)>>,
+}
+
+/// Turns any displayable error into the message [`PlotError::Draw`] carries.
+pub trait OrMsg<T> {
+    /// The error's text.
+    fn msg(self) -> Result<T, String>;
+}
+
+impl<T, E: std::fmt::Display> OrMsg<T> for Result<T, E> {
+    fn msg(self) -> Result<T, String> {
+        self.map_err(|e| e.to_string())
+    }
+}
+
+impl Canvas {
+    /// The backend kind.
+    pub fn mode(&self) -> Mode {
+        self.mode
+    }
+
+    /// Draws `raster` with its upper-left corner at backend pixel
+    /// `upper_left` (on the root area).
+    pub fn place<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+        upper_left: (i32, i32),
+        raster: Raster,
+    ) -> Result<(), String> {
+        match self.mode {
+            Mode::Png => {
+                for (k, px) in raster.rgba.chunks_exact(4).enumerate() {
+                    if px[3] == 0 {
+                        continue;
+                    }
+                    let x = upper_left.0 + (k as u32 % raster.width) as i32;
+                    let y = upper_left.1 + (k as u32 / raster.width) as i32;
+                    let colour = RGBAColor(px[0], px[1], px[2], px[3] as f64 / 255.0);
+                    root.draw_pixel((x, y), &colour).msg()?;
+                }
+                Ok(())
+            }
+            Mode::Svg => {
+                let mut pending = self.pending.borrow_mut();
+                let id = u8::try_from(pending.len() + 1).map_err(|_| "too many rasters")?;
+                let (w, h) = (raster.width as i32, raster.height as i32);
+                root.draw(&Rectangle::new(
+                    [upper_left, (upper_left.0 + w, upper_left.1 + h)],
+                    placeholder(id).filled(),
+                ))
+                .msg()?;
+                pending.push((id, upper_left, raster));
+                Ok(())
+            }
+        }
+    }
+}
+
+/// The reserved colour of raster placeholder `id`.
+fn placeholder(id: u8) -> RGBColor {
+    RGBColor(1, 2, id)
+}
+
+/// A chart that draws itself on any plotters backend.
+pub trait Chart: Sync {
+    /// File stem (`map-t30`, `params`, ...).
+    fn name(&self) -> String;
+    /// Size in pixels (the SVG's view box).
+    fn size(&self) -> (u32, u32);
+    /// Draws on `root`, already filled white.
+    fn draw<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+        canvas: &Canvas,
+    ) -> Result<(), String>;
+}
+
+fn draw_error(chart: &impl Chart, message: String) -> PlotError {
+    PlotError::Draw {
+        name: chart.name(),
+        message,
+    }
+}
+
+/// Renders `chart` as SVG text.
+pub fn render_svg(chart: &impl Chart) -> Result<String, PlotError> {
+    register_fonts();
+    let canvas = Canvas {
+        mode: Mode::Svg,
+        pending: RefCell::new(Vec::new()),
+    };
+    let mut text = String::new();
+    {
+        let root = SVGBackend::with_string(&mut text, chart.size()).into_drawing_area();
+        root.fill(&WHITE)
+            .msg()
+            .and_then(|_| chart.draw(&root, &canvas))
+            .and_then(|_| root.present().msg())
+            .map_err(|m| draw_error(chart, m))?;
+    }
+    for (id, (x, y), raster) in canvas.pending.into_inner() {
+        let image = format!(
+            r#"<image x="{x}" y="{y}" width="{}" height="{}" preserveAspectRatio="none" href="data:image/png;base64,{}"/>"#,
+            raster.width,
+            raster.height,
+            base64(
+                &encode_png(
+                    raster.width,
+                    raster.height,
+                    png::ColorType::Rgba,
+                    &raster.rgba
+                )
+                .map_err(|m| draw_error(chart, m))?
+            )
+        );
+        let marker = format!(
+            "fill=\"#{:02X}{:02X}{:02X}\"",
+            placeholder(id).0,
+            placeholder(id).1,
+            placeholder(id).2
+        );
+        let at = text
+            .find(&marker)
+            .ok_or_else(|| draw_error(chart, "raster placeholder not found".into()))?;
+        let start = text[..at]
+            .rfind("<rect")
+            .ok_or_else(|| draw_error(chart, "raster placeholder not found".into()))?;
+        let end = at + text[at..].find("/>").unwrap_or(0) + 2;
+        text.replace_range(start..end, &image);
+    }
+    Ok(text)
+}
+
+/// Renders `chart` as PNG bytes.
+pub fn render_png(chart: &impl Chart) -> Result<Vec<u8>, PlotError> {
+    register_fonts();
+    let (w, h) = chart.size();
+    let mut pixels = vec![255u8; (w * h * 3) as usize];
+    let canvas = Canvas {
+        mode: Mode::Png,
+        pending: RefCell::new(Vec::new()),
+    };
+    {
+        let root = BitMapBackend::with_buffer(&mut pixels, (w, h)).into_drawing_area();
+        root.fill(&WHITE)
+            .msg()
+            .and_then(|_| chart.draw(&root, &canvas))
+            .and_then(|_| root.present().msg())
+            .map_err(|m| draw_error(chart, m))?;
+    }
+    encode_png(w, h, png::ColorType::Rgb, &pixels).map_err(|m| draw_error(chart, m))
+}
+
+/// Encodes 8-bit pixels as PNG.
+pub fn encode_png(w: u32, h: u32, colour: png::ColorType, data: &[u8]) -> Result<Vec<u8>, String> {
+    let mut out = Vec::new();
+    let mut encoder = png::Encoder::new(&mut out, w, h);
+    encoder.set_color(colour);
+    encoder.set_depth(png::BitDepth::Eight);
+    encoder.set_compression(png::Compression::Fast);
+    let mut writer = encoder.write_header().msg()?;
+    writer.write_image_data(data).msg()?;
+    writer.finish().msg()?;
+    Ok(out)
+}
+
+/// Standard base64 with padding.
+pub fn base64(bytes: &[u8]) -> String {
+    const ALPHABET: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut out = String::with_capacity(bytes.len().div_ceil(3) * 4);
+    for chunk in bytes.chunks(3) {
+        let b = [
+            chunk[0],
+            *chunk.get(1).unwrap_or(&0),
+            *chunk.get(2).unwrap_or(&0),
+        ];
+        let n = (u32::from(b[0]) << 16) | (u32::from(b[1]) << 8) | u32::from(b[2]);
+        for k in 0..4 {
+            if k <= chunk.len() {
+                out.push(ALPHABET[((n >> (18 - 6 * k)) & 63) as usize] as char);
+            } else {
+                out.push('=');
+            }
+        }
+    }
+    out
+}
+
+/// Writes `bytes` to `path` through a temporary file in the same folder
+/// and a rename, so a reader never sees half a file.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), PlotError> {
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    std::fs::create_dir_all(dir).map_err(|source| PlotError::Io {
+        path: dir.to_path_buf(),
+        what: "cannot create folder",
+        source,
+    })?;
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = dir.join(format!(
+        ".{name}.{}.{:?}.tmp",
+        std::process::id(),
+        std::thread::current().id()
+    ));
+    let result = (|| -> std::io::Result<()> {
+        let mut file = std::fs::File::create(&tmp)?;
+        file.write_all(bytes)?;
+        file.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result.map_err(|source| PlotError::Io {
+        path: path.to_path_buf(),
+        what: "cannot write",
+        source,
+    })
+}
+
+/// Renders `chart` and writes `<dir>/<name>.svg` and `<dir>/<name>.png`.
+pub fn write_chart(chart: &impl Chart, dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
+    let (svg, png) = rayon::join(|| render_svg(chart), || render_png(chart));
+    let svg_path = dir.join(format!("{}.svg", chart.name()));
+    let png_path = dir.join(format!("{}.png", chart.name()));
+    write_atomic(&svg_path, svg?.as_bytes())?;
+    write_atomic(&png_path, &png?)?;
+    Ok(vec![svg_path, png_path])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn base64_matches_the_rfc_examples() {
+        assert_eq!(base64(b""), "");
+        assert_eq!(base64(b"f"), "Zg==");
+        assert_eq!(base64(b"fo"), "Zm8=");
+        assert_eq!(base64(b"foo"), "Zm9v");
+        assert_eq!(base64(b"foobar"), "Zm9vYmFy");
+    }
+}

@@ -1,0 +1,369 @@
+//! # brtf-plot: residual plots and the report of a brtf fit
+//!
+//! Reads a fit ([`brtf_fit::FitResult`], the fit folder's `fit.json`) and
+//! the measurement files it names, rebuilds the data exactly as `brtf fit`
+//! compared them (conversion to BSDF, free scale, selections; see
+//! [`prepare`]), and draws, as SVG and PNG each, into `<fit folder>/plots/`:
+//!
+//! | file | what |
+//! |---|---|
+//! | `map-<tag>` | per incidence: model ÷ data over the hemisphere, equal-area disk, diverging colour bar; light, mirror, beam mask, θ cap and unfitted samples marked |
+//! | `cut-<tag>` | per incidence: the plane of incidence, data and model on a log axis, masked ranges shaded |
+//! | `params` | every fitted parameter over θ_in with ±1 standard error, the θ_in interpolation and the all-incidence fit |
+//! | `rho` | ρ_dh (and τ_dh) over θ_in: data against model |
+//! | `rms` | the error of every incidence's fit |
+//! | `cuts` | every incidence's cut in one chart |
+//!
+//! `<tag>` is `t<θ_in>` (e.g. `t30`, `t26.8421`), with `-p<φ_in>` when
+//! φ_in ≠ 0 or θ_in repeats. Then it writes `<fit folder>/report.html`,
+//! which shows all of them with the parameter table, the exported
+//! material text and the provenance, and needs nothing but a browser.
+//!
+//! Text is drawn with the DejaVu Sans font embedded in the binary (plotters
+//! with `ab_glyph`, no fontconfig), so plotting works on a bare machine.
+//! Every file is written atomically (temporary file + rename).
+//!
+//! A measurement file that cannot be found or read does not stop the
+//! plots: that incidence's map and cut are skipped and the report says
+//! why ([`Written::warnings`]).
+//!
+//! ```no_run
+//! let dir = std::path::Path::new("fits/alu-ggx");
+//! let result = brtf_plot::read_fit(dir)?;
+//! let written = brtf_plot::write_plots(dir, &result, &brtf_plot::PlotOptions::default())?;
+//! for w in &written.warnings {
+//!     eprintln!("warning: {w}");
+//! }
+//! # Ok::<(), brtf_plot::PlotError>(())
+//! ```
+
+pub mod charts;
+pub mod colour;
+pub mod disk;
+mod error;
+pub mod figure;
+pub mod prepare;
+pub mod report;
+
+pub use error::PlotError;
+
+use brtf_fit::FitResult;
+use charts::cut::{CutChart, CutsChart};
+use charts::map::MapChart;
+use charts::theta::{ParamsChart, RhoChart, RmsChart};
+use figure::{Chart, write_atomic, write_chart};
+use prepare::{DataUnit, Incidence};
+use rayon::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// Ratios offered for the ends of the map's colour bar.
+const NICE_RATIOS: [f64; 10] = [1.05, 1.1, 1.2, 1.5, 2.0, 3.0, 5.0, 10.0, 30.0, 100.0];
+
+/// How to plot.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PlotOptions {
+    /// Extra folders in which to look for measurement files whose recorded
+    /// path is relative (besides the current folder, the fit folder and
+    /// its ancestors).
+    pub search_dirs: Vec<PathBuf>,
+    /// The model ÷ data ratio `k > 1` at the ends of the maps' colour bar;
+    /// `None` picks the smallest of 1.05, 1.1, 1.2, 1.5, 2, 3, 5, 10, 30,
+    /// 100 that holds 95% of the fitted samples of every incidence.
+    pub ratio: Option<f64>,
+    /// Largest angle (degrees) between a sample and the plane of incidence
+    /// for the cuts; `None` picks the smallest of 0.25–3° that gives 60
+    /// fitted samples.
+    pub plane_tolerance_deg: Option<f64>,
+}
+
+/// What [`write_plots`] wrote.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Written {
+    /// Every file written: the plots (SVG and PNG) and the report.
+    pub files: Vec<PathBuf>,
+    /// `<dir>/report.html`.
+    pub report: PathBuf,
+    /// Plots that were skipped or may mislead, and why (also in the report).
+    pub warnings: Vec<String>,
+}
+
+/// Reads `<dir>/fit.json`.
+pub fn read_fit(dir: &Path) -> Result<FitResult, PlotError> {
+    let path = dir.join("fit.json");
+    let text = std::fs::read_to_string(&path).map_err(|source| PlotError::Io {
+        path: path.clone(),
+        what: "cannot read",
+        source,
+    })?;
+    serde_json::from_str(&text).map_err(|e| PlotError::FitJson {
+        path,
+        line: e.line(),
+        message: e.to_string(),
+    })
+}
+
+/// The colour-bar ratio for the maps (see [`PlotOptions::ratio`]).
+fn auto_ratio(incs: &[&Incidence]) -> f64 {
+    let mut all: Vec<f64> = incs
+        .iter()
+        .flat_map(|i| {
+            i.samples
+                .iter()
+                .filter(|s| s.used())
+                .map(|s| i.log_ratio(s).abs())
+        })
+        .filter(|v| v.is_finite())
+        .collect();
+    if all.is_empty() {
+        return 2.0;
+    }
+    let k = ((all.len() - 1) as f64 * 0.95) as usize;
+    let q = *all.select_nth_unstable_by(k, f64::total_cmp).1;
+    NICE_RATIOS
+        .into_iter()
+        .find(|r| r.ln() >= q)
+        .unwrap_or(NICE_RATIOS[NICE_RATIOS.len() - 1])
+}
+
+/// Median of |model ÷ data − 1| over the fitted samples (via the log ratio).
+fn median_deviation(inc: &Incidence) -> Option<f64> {
+    let mut v: Vec<f64> = inc
+        .samples
+        .iter()
+        .filter(|s| s.used())
+        .map(|s| inc.log_ratio(s).abs())
+        .collect();
+    if v.is_empty() {
+        return None;
+    }
+    let k = v.len() / 2;
+    Some(v.select_nth_unstable_by(k, f64::total_cmp).1.exp() - 1.0)
+}
+
+/// One of the charts to draw.
+enum Job<'a> {
+    Map(MapChart<'a>),
+    Cut(CutChart<'a>),
+    Cuts(CutsChart<'a>),
+    Params(ParamsChart<'a>),
+    Rho(RhoChart<'a>),
+    Rms(RmsChart<'a>),
+}
+
+impl Job<'_> {
+    fn write(&self, dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
+        match self {
+            Job::Map(c) => write_chart(c, dir),
+            Job::Cut(c) => write_chart(c, dir),
+            Job::Cuts(c) => write_chart(c, dir),
+            Job::Params(c) => write_chart(c, dir),
+            Job::Rho(c) => write_chart(c, dir),
+            Job::Rms(c) => write_chart(c, dir),
+        }
+    }
+}
+
+/// Draws every plot of `result` into `<dir>/plots/` and writes
+/// `<dir>/report.html` (see the crate docs). `dir` is the fit folder: the
+/// report embeds the `.rad` files found there and links `fit.json` and
+/// `params.csv`. Plots of an earlier run that this run did not draw again
+/// (`map-*`, `cut-*`) are removed.
+pub fn write_plots(
+    dir: &Path,
+    result: &FitResult,
+    options: &PlotOptions,
+) -> Result<Written, PlotError> {
+    if result.incidences.is_empty() {
+        return Err(PlotError::NoIncidences);
+    }
+    let plots = dir.join("plots");
+    let tags = prepare::tags(&result.incidences);
+    let loaded: Vec<Result<Incidence, String>> = (0..result.incidences.len())
+        .into_par_iter()
+        .map(|k| prepare::load(result, k, tags[k].clone(), dir, &options.search_dirs))
+        .collect();
+    let mut warnings: Vec<String> = Vec::new();
+    for l in &loaded {
+        match l {
+            Ok(inc) => warnings.extend(inc.warnings.iter().cloned()),
+            Err(why) => warnings.push(why.clone()),
+        }
+    }
+    let incs: Vec<&Incidence> = loaded.iter().filter_map(|l| l.as_ref().ok()).collect();
+    let ratio = options
+        .ratio
+        .filter(|r| r.is_finite() && *r > 1.0)
+        .unwrap_or_else(|| auto_ratio(&incs));
+    let unit = incs.first().map_or_else(
+        || {
+            if result.config.free_scale {
+                DataUnit::RawPerCos("data unit".into())
+            } else {
+                DataUnit::Bsdf
+            }
+        },
+        |i| i.unit.clone(),
+    );
+    let channels = incs.first().map_or(1, |i| i.channels);
+    let by_index: Vec<Option<&Incidence>> = loaded.iter().map(|l| l.as_ref().ok()).collect();
+    let medians: Vec<Option<f64>> = by_index
+        .iter()
+        .map(|i| i.and_then(median_deviation))
+        .collect();
+    let name = &result.name;
+    let model = result.config.kind.name();
+
+    let mut jobs: Vec<Job> = Vec::new();
+    for inc in &incs {
+        let report = &result.incidences[inc.index];
+        let label = charts::incidence_label(inc.theta_in, inc.phi_in);
+        jobs.push(Job::Map(MapChart::new(
+            inc,
+            format!("{name} ({model}), {label}: model ÷ data over the hemisphere"),
+            ratio,
+            report.rms_rel,
+        )));
+        jobs.push(Job::Cut(CutChart {
+            inc,
+            title: format!("{name} ({model}), {label}: cut through the plane of incidence"),
+            tolerance: options.plane_tolerance_deg,
+        }));
+    }
+    let params = ParamsChart {
+        result,
+        unit: unit.clone(),
+        title: format!("{name} ({model}): fitted parameters over θ_in"),
+    };
+    let rho = RhoChart {
+        result,
+        incs: by_index.clone(),
+        integrals: Default::default(),
+        unit: unit.clone(),
+        channels,
+        title: format!("{name} ({model}): hemispherical reflectance, data against model"),
+    };
+    let rms = RmsChart {
+        result,
+        medians,
+        title: format!("{name} ({model}): error of each incidence's fit"),
+    };
+    let mut overview = vec![
+        (
+            params.name(),
+            params.size(),
+            "Fitted parameters over θ_in: dots with ±1 standard-error bars per incidence, the θ_in \
+             interpolation the exported material uses, and the all-incidence fit (dashed)."
+                .to_string(),
+        ),
+        (
+            rho.name(),
+            rho.size(),
+            "Directional-hemispherical reflectance: the data summed over the fitted samples, the model \
+             over the same samples, and the model over the whole hemisphere."
+                .to_string(),
+        ),
+        (
+            rms.name(),
+            rms.size(),
+            "Error per incidence: the fit's RMS relative error and the median |model ÷ data − 1|."
+                .to_string(),
+        ),
+    ];
+    jobs.push(Job::Params(params));
+    jobs.push(Job::Rho(rho));
+    jobs.push(Job::Rms(rms));
+    if !incs.is_empty() {
+        let cuts = CutsChart {
+            incs: incs.clone(),
+            title: format!(
+                "{name} ({model}): in-plane cuts of every incidence (dots: data, lines: model)"
+            ),
+            tolerance: options.plane_tolerance_deg,
+        };
+        overview.push((
+            cuts.name(),
+            cuts.size(),
+            "Every incidence's cut through its plane of incidence: fitted data near the plane (dots) and the \
+             fitted model (lines), one colour per incidence."
+                .to_string(),
+        ));
+        jobs.push(Job::Cuts(cuts));
+    }
+
+    let written: Vec<Result<Vec<PathBuf>, PlotError>> =
+        jobs.par_iter().map(|j| j.write(&plots)).collect();
+    let mut files = Vec::new();
+    for w in written {
+        files.extend(w?);
+    }
+    remove_stale(&plots, &files);
+
+    let entries = result
+        .incidences
+        .iter()
+        .zip(&loaded)
+        .zip(&tags)
+        .map(|((report, l), tag)| {
+            let data = l.as_ref().map_err(String::as_str);
+            let charts = match data {
+                Ok(inc) => {
+                    let map = MapChart::new(inc, String::new(), ratio, report.rms_rel);
+                    let cut = CutChart {
+                        inc,
+                        title: String::new(),
+                        tolerance: None,
+                    };
+                    vec![
+                        (map.name(), map.size(), "model ÷ data over the hemisphere"),
+                        (cut.name(), cut.size(), "cut through the plane of incidence"),
+                    ]
+                }
+                Err(_) => Vec::new(),
+            };
+            report::IncidenceEntry {
+                report,
+                tag: tag.clone(),
+                data,
+                charts,
+            }
+        })
+        .collect();
+    let html = report::html(&report::ReportInput {
+        dir,
+        result,
+        overview,
+        incidences: entries,
+        warnings: &warnings,
+        ratio,
+    });
+    let report_path = dir.join("report.html");
+    write_atomic(&report_path, html.as_bytes())?;
+    files.push(report_path.clone());
+    Ok(Written {
+        files,
+        report: report_path,
+        warnings,
+    })
+}
+
+/// Reads `<dir>/fit.json` and runs [`write_plots`].
+pub fn plot_dir(dir: &Path, options: &PlotOptions) -> Result<Written, PlotError> {
+    let result = read_fit(dir)?;
+    write_plots(dir, &result, options)
+}
+
+/// Removes `map-*` and `cut-*` plots that this run did not write.
+fn remove_stale(plots: &Path, written: &[PathBuf]) {
+    let Ok(entries) = std::fs::read_dir(plots) else {
+        return;
+    };
+    for e in entries.filter_map(|e| e.ok()) {
+        let path = e.path();
+        let name = e.file_name().to_string_lossy().into_owned();
+        let ours = (name.starts_with("map-") || name.starts_with("cut-"))
+            && (name.ends_with(".svg") || name.ends_with(".png"));
+        if ours && !written.contains(&path) {
+            let _ = std::fs::remove_file(&path);
+        }
+    }
+}

@@ -1,0 +1,436 @@
+//! `report.html`: one self-contained page per fit folder that shows every
+//! plot, the parameter table, the exported material text and the
+//! provenance. Plain HTML and CSS, no script, no web font, no remote
+//! resource: it opens offline in any browser. Plots are linked relative
+//! to the fit folder (`plots/<name>.svg`, with the PNG one click away).
+
+use crate::charts::{fmt, incidence_label};
+use crate::prepare::{Gate, Incidence, num};
+use brtf_fit::{FitReport, FitResult};
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// The largest material file embedded as text.
+const MAX_EMBED: u64 = 256 * 1024;
+
+/// What the report shows of one incidence.
+pub struct IncidenceEntry<'a> {
+    /// The fit report.
+    pub report: &'a FitReport,
+    /// File-name tag (`t30`).
+    pub tag: String,
+    /// The loaded data, or why there is none.
+    pub data: Result<&'a Incidence, &'a str>,
+    /// File stems of its charts (map, cut), when drawn.
+    pub charts: Vec<(String, (u32, u32), &'static str)>,
+}
+
+/// Everything the report needs.
+pub struct ReportInput<'a> {
+    /// The fit folder (for the exported files).
+    pub dir: &'a Path,
+    /// The fit.
+    pub result: &'a FitResult,
+    /// Charts over θ_in: `(stem, size, caption)`.
+    pub overview: Vec<(String, (u32, u32), String)>,
+    /// One entry per incidence.
+    pub incidences: Vec<IncidenceEntry<'a>>,
+    /// Warnings about the plots.
+    pub warnings: &'a [String],
+    /// Colour-bar ratio of the maps.
+    pub ratio: f64,
+}
+
+/// HTML-escapes text.
+pub fn esc(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&#39;"),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// Escapes a relative path for an `href`/`src` attribute.
+fn href(path: &str) -> String {
+    let mut out = String::new();
+    for b in path.bytes() {
+        match b {
+            b'A'..=b'Z' | b'a'..=b'z' | b'0'..=b'9' | b'-' | b'_' | b'.' | b'/' | b'~' => {
+                out.push(b as char)
+            }
+            _ => {
+                let _ = write!(out, "%{b:02X}");
+            }
+        }
+    }
+    out
+}
+
+const STYLE: &str = r#"
+body { font-family: system-ui, -apple-system, "Segoe UI", Roboto, "DejaVu Sans", sans-serif;
+       margin: 0 auto; max-width: 1320px; padding: 0 20px 60px; color: #111; line-height: 1.45; }
+h1 { margin: 24px 0 4px; font-size: 1.7em; }
+h2 { margin-top: 38px; border-bottom: 2px solid #ddd; padding-bottom: 4px; }
+h3 { margin: 28px 0 6px; }
+nav a { margin-right: 14px; }
+.muted { color: #555; }
+table { border-collapse: collapse; margin: 10px 0; font-size: 0.92em; }
+th, td { border: 1px solid #ccc; padding: 3px 8px; text-align: right; vertical-align: top; }
+th { background: #f1f1f1; }
+td.l, th.l { text-align: left; }
+tr.global td { background: #f8f8f8; font-weight: 600; }
+.bound { color: #c00; font-weight: 700; }
+.warn { background: #fff4e0; border: 1px solid #e0a040; padding: 8px 14px; border-radius: 4px; }
+.warn li { margin: 3px 0; }
+figure { margin: 14px 0 22px; }
+figure img { max-width: 100%; height: auto; border: 1px solid #e4e4e4; }
+figcaption { font-size: 0.9em; color: #333; margin-top: 4px; }
+.pair { display: flex; flex-wrap: wrap; gap: 18px; align-items: flex-start; }
+.pair figure { flex: 1 1 560px; margin: 6px 0; }
+pre { background: #f6f6f6; border: 1px solid #ddd; padding: 10px; overflow-x: auto; font-size: 0.88em; }
+code { font-size: 0.95em; }
+"#;
+
+fn figure(out: &mut String, stem: &str, size: (u32, u32), caption: &str) {
+    let svg = href(&format!("plots/{stem}.svg"));
+    let png = href(&format!("plots/{stem}.png"));
+    let _ = write!(
+        out,
+        "<figure id=\"fig-{id}\"><a href=\"{png}\"><img src=\"{svg}\" width=\"{w}\" height=\"{h}\" \
+         alt=\"{alt}\" loading=\"lazy\"></a><figcaption>{caption} \
+         <span class=\"muted\">(<a href=\"{svg}\">SVG</a> · <a href=\"{png}\">PNG</a>)</span>\
+         </figcaption></figure>\n",
+        id = esc(stem),
+        w = size.0,
+        h = size.1,
+        alt = esc(caption),
+    );
+}
+
+fn param_cell(r: &FitReport, name: &str) -> String {
+    match r.params.iter().find(|p| p.name == name) {
+        None => "–".into(),
+        Some(p) if p.fixed => format!("{} <span class=\"muted\">(fixed)</span>", fmt6(p.value)),
+        Some(p) if p.at_bound => format!(
+            "{} <span class=\"bound\" title=\"at a bound: the standard error is meaningless\">!</span>",
+            fmt6(p.value)
+        ),
+        Some(p) => format!("{} ± {}", fmt6(p.value), fmt_err(p.stderr)),
+    }
+}
+
+fn fmt6(v: f64) -> String {
+    format!("{v:.6}")
+}
+
+fn fmt_err(v: f64) -> String {
+    if v.is_finite() {
+        format!("{v:.1e}")
+    } else {
+        "?".into()
+    }
+}
+
+fn param_table(out: &mut String, result: &FitResult) {
+    let Some(first) = result.incidences.first() else {
+        return;
+    };
+    let names: Vec<&str> = first.params.iter().map(|p| p.name.as_str()).collect();
+    out.push_str(
+        "<table id=\"param-table\"><thead><tr><th>θ_in [°]</th><th>φ_in [°]</th><th>points</th>",
+    );
+    for n in &names {
+        let _ = write!(out, "<th>{}</th>", esc(n));
+    }
+    out.push_str("<th>RMS rel.</th><th class=\"l\">termination</th></tr></thead><tbody>\n");
+    let mut row = |r: &FitReport, label: String, phi: String, class: &str| {
+        let _ = write!(
+            out,
+            "<tr class=\"{class}\"><td>{label}</td><td>{phi}</td><td>{}</td>",
+            r.n_points
+        );
+        for n in &names {
+            let _ = write!(out, "<td>{}</td>", param_cell(r, n));
+        }
+        let _ = writeln!(
+            out,
+            "<td>{}</td><td class=\"l\">{}</td></tr>",
+            fmt(r.rms_rel),
+            esc(r.termination.label())
+        );
+    };
+    for r in &result.incidences {
+        row(r, num(r.theta_in), num(r.phi_in), "incidence");
+    }
+    if let Some(g) = &result.global {
+        row(g, "all".into(), String::new(), "global");
+    }
+    out.push_str("</tbody></table>\n");
+    out.push_str(
+        "<p class=\"muted\">value ± standard error from s²(JᵀJ)⁻¹; \
+         <span class=\"bound\">!</span> = ended at a physical bound (its error is meaningless); \
+         “all” = one parameter set fitted to every incidence at once. \
+         RMS rel. = RMS of (model − data) ÷ √(data² + floor²).</p>\n",
+    );
+}
+
+fn material_section(out: &mut String, dir: &Path, result: &FitResult) {
+    let mut files: Vec<String> = std::fs::read_dir(dir)
+        .map(|rd| {
+            rd.filter_map(|e| e.ok())
+                .filter(|e| e.path().is_file())
+                .map(|e| e.file_name().to_string_lossy().into_owned())
+                .filter(|n| n.ends_with(".rad") || n.ends_with(".cal"))
+                .filter(|n| !n.starts_with('.'))
+                .collect()
+        })
+        .unwrap_or_default();
+    files.sort();
+    let main = format!("{}.rad", result.name);
+    if let Some(i) = files.iter().position(|f| *f == main) {
+        let f = files.remove(i);
+        files.insert(0, f);
+    }
+    if files.is_empty() {
+        let _ = writeln!(
+            out,
+            "<p class=\"muted\">No exported material in this folder yet \
+             (<code>brtf export {}</code> writes <code>{}</code>).</p>",
+            esc(&dir.display().to_string()),
+            esc(&main)
+        );
+        return;
+    }
+    for f in &files {
+        let path = dir.join(f);
+        let _ = writeln!(out, "<h3><a href=\"{}\">{}</a></h3>", href(f), esc(f));
+        let small = std::fs::metadata(&path)
+            .map(|m| m.len() <= MAX_EMBED)
+            .unwrap_or(false);
+        if f.ends_with(".rad") && small {
+            match std::fs::read_to_string(&path) {
+                Ok(text) => {
+                    let _ = writeln!(out, "<pre class=\"material\">{}</pre>", esc(&text));
+                }
+                Err(e) => {
+                    let _ = writeln!(
+                        out,
+                        "<p class=\"muted\">cannot read: {}</p>",
+                        esc(&e.to_string())
+                    );
+                }
+            }
+        }
+    }
+}
+
+fn provenance_section(out: &mut String, dir: &Path, result: &FitResult) {
+    let p = &result.provenance;
+    let _ = writeln!(
+        out,
+        "<p>Made by brtf {} on {}.</p>\n<p>Command:</p>\n<pre>{}</pre>",
+        esc(&p.brtf_version),
+        esc(&p.created),
+        esc(&p.command_line.join(" "))
+    );
+    out.push_str(
+        "<table id=\"inputs\"><thead><tr><th class=\"l\">file</th><th>θ_in [°]</th><th>φ_in [°]</th>\
+         <th>samples</th><th class=\"l\">quantity (as fitted)</th><th class=\"l\">SHA-256</th></tr></thead><tbody>\n",
+    );
+    for i in &p.inputs {
+        let _ = writeln!(
+            out,
+            "<tr><td class=\"l\"><code>{}</code></td><td>{}</td><td>{}</td><td>{}</td><td class=\"l\">{}</td>\
+             <td class=\"l\"><code>{}</code></td></tr>",
+            esc(&i.path),
+            num(i.theta_in),
+            num(i.phi_in),
+            i.samples,
+            esc(&i.quantity),
+            esc(&i.sha256)
+        );
+    }
+    out.push_str("</tbody></table>\n");
+    let c = &result.config;
+    let _ = writeln!(
+        out,
+        "<table id=\"config\"><tbody>\
+         <tr><th class=\"l\">model</th><td class=\"l\">{} ({} variant, Fresnel K {}, source ω {} sr)</td></tr>\
+         <tr><th class=\"l\">gray (R = G = B)</th><td class=\"l\">{}</td></tr>\
+         <tr><th class=\"l\">free scale</th><td class=\"l\">{}</td></tr>\
+         <tr><th class=\"l\">residuals</th><td class=\"l\">{:?}, floor {}</td></tr>\
+         <tr><th class=\"l\">robust loss</th><td class=\"l\">{:?}</td></tr>\
+         <tr><th class=\"l\">multi-start</th><td class=\"l\">{}</td></tr>\
+         <tr><th class=\"l\">θ_in interpolation</th><td class=\"l\">{:?}</td></tr>\
+         <tr><th class=\"l\">selections</th><td class=\"l\">{}</td></tr>\
+         </tbody></table>",
+        esc(c.kind.name()),
+        esc(c.options.variant.name()),
+        c.options.fresnel_k,
+        c.options.source_omega,
+        c.gray,
+        c.free_scale,
+        c.residual,
+        c.floor.map_or("auto".into(), fmt),
+        c.loss,
+        c.multistart,
+        result.interpolation,
+        esc(&result.selections.join("; "))
+    );
+    let mut links = Vec::new();
+    for f in ["fit.json", "params.csv"] {
+        if dir.join(f).is_file() {
+            links.push(format!("<a href=\"{}\">{}</a>", href(f), esc(f)));
+        }
+    }
+    if !links.is_empty() {
+        let _ = writeln!(out, "<p>Machine-readable: {}.</p>", links.join(" · "));
+    }
+}
+
+/// The page.
+pub fn html(input: &ReportInput) -> String {
+    let result = input.result;
+    let mut out = String::new();
+    let title = format!("{}: brtf fit report", result.name);
+    let _ = write!(
+        out,
+        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
+         <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n\
+         <link rel=\"icon\" href=\"data:,\">\n<title>{}</title>\n<style>{STYLE}</style>\n</head>\n<body>\n",
+        esc(&title)
+    );
+    let _ = writeln!(out, "<h1>{}</h1>", esc(&title));
+    let _ = writeln!(
+        out,
+        "<p class=\"muted\">Radiance <code>{}</code> ({} variant) fitted to {} incidence(s); made {} by brtf {}.</p>",
+        esc(result.config.kind.name()),
+        esc(result.config.options.variant.name()),
+        result.incidences.len(),
+        esc(&result.provenance.created),
+        esc(&result.provenance.brtf_version)
+    );
+    out.push_str(
+        "<nav><a href=\"#parameters\">Parameters</a><a href=\"#theta\">Over θ_in</a>\
+         <a href=\"#incidences\">Per incidence</a><a href=\"#material\">Material</a>\
+         <a href=\"#provenance\">Provenance</a></nav>\n",
+    );
+
+    let fit_warnings: Vec<String> = result
+        .incidences
+        .iter()
+        .chain(result.global.iter())
+        .flat_map(|r| {
+            r.warnings
+                .iter()
+                .map(move |w| format!("{} (θ_in {}°): {w}", r.source, num(r.theta_in)))
+        })
+        .collect();
+    if !input.warnings.is_empty() || !fit_warnings.is_empty() {
+        out.push_str(
+            "<section id=\"warnings\" class=\"warn\"><strong>Read this first</strong><ul>\n",
+        );
+        for w in input.warnings.iter().chain(&fit_warnings) {
+            let _ = writeln!(out, "<li>{}</li>", esc(w));
+        }
+        out.push_str("</ul></section>\n");
+    }
+
+    out.push_str("<section id=\"parameters\"><h2>Parameters</h2>\n");
+    param_table(&mut out, result);
+    out.push_str("</section>\n");
+
+    out.push_str("<section id=\"theta\"><h2>Over θ_in</h2>\n");
+    for (stem, size, caption) in &input.overview {
+        figure(&mut out, stem, *size, caption);
+    }
+    out.push_str("</section>\n");
+
+    out.push_str("<section id=\"incidences\"><h2>Per incidence</h2>\n");
+    let _ = writeln!(
+        out,
+        "<p class=\"muted\">Maps: model ÷ data on an equal-area view of the hemisphere, blue where the model \
+         is below the data, red where above; the colour bar ends at ×{} and ×1/{}; grey samples were \
+         not fitted. Cuts: the plane of incidence, data as dots, the model as a line, masked ranges shaded.</p>",
+        fmt(input.ratio),
+        fmt(input.ratio)
+    );
+    for entry in &input.incidences {
+        let r = entry.report;
+        let label = incidence_label(r.theta_in, r.phi_in);
+        let _ = writeln!(
+            out,
+            "<h3 id=\"inc-{}\">{}</h3>",
+            esc(&entry.tag),
+            esc(&label)
+        );
+        let _ = write!(
+            out,
+            "<p><code>{}</code>: {} samples fitted, RMS rel. {}",
+            esc(&r.source),
+            r.n_points,
+            fmt(r.rms_rel)
+        );
+        if !r.gates.is_empty() {
+            let gates: Vec<String> = r
+                .gates
+                .iter()
+                .map(|g| format!("{} (−{})", esc(&g.gate), g.removed))
+                .collect();
+            let _ = write!(out, "; selections: {}", gates.join(", "));
+        }
+        out.push_str(".</p>\n");
+        match &entry.data {
+            Err(why) => {
+                let _ = writeln!(out, "<p class=\"warn\">No map or cut: {}</p>", esc(why));
+            }
+            Ok(inc) => {
+                for w in &inc.warnings {
+                    let _ = writeln!(out, "<p class=\"warn\">{}</p>", esc(w));
+                }
+                if inc.gates.iter().any(|g| matches!(g, Gate::Unknown(_))) {
+                    out.push_str(
+                        "<p class=\"muted\">Some selections could not be reproduced.</p>\n",
+                    );
+                }
+                out.push_str("<div class=\"pair\">\n");
+                for (stem, size, what) in &entry.charts {
+                    figure(&mut out, stem, *size, &format!("{label}: {what}"));
+                }
+                out.push_str("</div>\n");
+            }
+        }
+    }
+    out.push_str("</section>\n");
+
+    out.push_str("<section id=\"material\"><h2>Exported material</h2>\n");
+    material_section(&mut out, input.dir, result);
+    out.push_str("</section>\n");
+
+    out.push_str("<section id=\"provenance\"><h2>Provenance</h2>\n");
+    provenance_section(&mut out, input.dir, result);
+    out.push_str("</section>\n</body>\n</html>\n");
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn escaping() {
+        assert_eq!(
+            esc("<a href=\"x\">&'"),
+            "&lt;a href=&quot;x&quot;&gt;&amp;&#39;"
+        );
+        assert_eq!(href("plots/map-t26.8421.svg"), "plots/map-t26.8421.svg");
+        assert_eq!(href("a b:c.rad"), "a%20b%3Ac.rad");
+    }
+}
