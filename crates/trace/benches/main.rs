@@ -246,7 +246,7 @@ fn vs_rtrace() {
             }
         }
     }
-    // brtf-trace first, on one thread.
+    // brtf-trace on one thread.
     let options = ImageOptions {
         width: w,
         height: h,
@@ -259,15 +259,16 @@ fn vs_rtrace() {
         .num_threads(1)
         .build()
         .unwrap();
+    // Alternate the two, five runs each, and keep the best of each, so
+    // that other load on the machine hits both alike.
     let mut best_ours = f64::INFINITY;
+    let mut best_rtrace = f64::INFINITY;
     let mut rays = RayCounts::default();
-    for _ in 0..3 {
+    for _ in 0..5 {
         let r = pool.install(|| brtf_trace::render(&scene, &cam, &options));
         best_ours = best_ours.min(r.elapsed.as_secs_f64());
         rays = r.rays;
-    }
-    let mut best_rtrace = f64::INFINITY;
-    for _ in 0..3 {
+
         let start = Instant::now();
         let mut child = cmd("rtrace")
             .args([
