@@ -336,6 +336,17 @@ pub fn run(args: FitArgs) -> Result<()> {
     };
     write_outputs(&out, &result)?;
     print!("{}", summary(&result, &out));
+    if !args.no_export {
+        let options = brtf_radiance::export::ExportOptions::default();
+        let exported = brtf_radiance::export::write_exports(&out, &result, &options)
+            .with_context(|| format!("exporting Radiance materials into {}", out.display()))?;
+        for file in &exported.files {
+            println!("wrote {}", file.display());
+        }
+        for note in &exported.notes {
+            eprintln!("note: {note}");
+        }
+    }
     Ok(())
 }
 
