@@ -225,3 +225,50 @@ fn renders_are_deterministic_and_thread_independent() {
     let (b, _) = pool.install(|| gonio.render(&dirs));
     assert_eq!(a, b);
 }
+
+#[test]
+fn table_materials_render_with_the_parameters_of_the_incidence() {
+    use brtf_fit::{Interpolation, ParamTable};
+    let table = ParamTable {
+        kind: MaterialKind::Metal,
+        orientation: [1.0, 0.0, 0.0],
+        method: Interpolation::Pchip,
+        theta_in: vec![0.0, 30.0, 60.0],
+        args: vec![
+            vec![0.9, 0.9, 0.9, 0.80, 0.08],
+            vec![0.9, 0.9, 0.9, 0.85, 0.10],
+            vec![0.9, 0.9, 0.9, 0.90, 0.14],
+        ],
+    };
+    let options = EvalOptions::default();
+    let shader = Shader::from_table(&table, &options).unwrap();
+    let omega = cone_solid_angle(0.01);
+    for theta_in in [0.0, 17.3, 30.0, 48.0, 60.0] {
+        let setup = GonioSetup {
+            theta_in,
+            phi_in: 0.0,
+            source_omega: omega,
+            detector_omega: omega,
+            samples: 16,
+            seed: 2,
+        };
+        let gonio = VirtualGonio::new(shader.clone(), setup);
+        let bsdf = Bsdf::new(&table.at(theta_in).unwrap().material, &options);
+        let dirs = directions(MaterialKind::Metal, 0.0);
+        let (values, _) = gonio.render(&dirs);
+        let peak = dirs
+            .iter()
+            .map(|&v| bsdf.eval(setup.light(), v)[0])
+            .fold(0.0, f64::max);
+        for (v, got) in dirs.iter().zip(&values) {
+            let want = bsdf.eval(setup.light(), *v)[0];
+            if want > 0.01 * peak {
+                assert!(
+                    (got.bsdf[0] - want).abs() < 5e-3 * want,
+                    "θ_in {theta_in}, v {v}: {} vs {want}",
+                    got.bsdf[0]
+                );
+            }
+        }
+    }
+}
