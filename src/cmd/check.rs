@@ -371,6 +371,7 @@ fn mask_beam(mut g: Geometry, half_angle_deg: f64) -> Geometry {
 }
 
 #[allow(clippy::too_many_arguments)]
+#[allow(clippy::needless_range_loop)] // channel loops index several arrays at once
 fn compare(
     shader: &Shader,
     material: &Material,
