@@ -13,5 +13,6 @@ mod common;
 mod eval;
 mod export;
 mod fit;
+mod plot;
 mod render;
 mod rtrace;

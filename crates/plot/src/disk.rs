@@ -9,10 +9,12 @@
 //! The back hemisphere is projected about the back normal with the same φ
 //! (seen through the sample from the front).
 //!
-//! The raster colours every pixel by its nearest sample, as long as that
-//! sample is no farther than its own distance to its nearest neighbour or
-//! a minimum reach, whichever is larger (the maps use 2.5°): the map shows
-//! the measured layout, and gaps wider than twice that stay white.
+//! [`Coverage`] gives every pixel of the disk to its nearest sample, as
+//! long as that sample is no farther than its own distance to its nearest
+//! neighbour or [`FILL_DEG`], whichever is larger: gaps wider than twice
+//! that stay uncovered. The maps colour the pixels by their owner, and as
+//! every pixel stands for the same solid angle, the same grid is the
+//! quadrature of the hemispherical integrals.
 
 use brtf_gonio::Hemisphere;
 use glam::DVec3;
@@ -169,59 +171,109 @@ impl Grid {
     }
 }
 
-/// Colours a `size × size` raster of the disk (pixel centres span
-/// [−RADIUS, RADIUS], y up): each pixel takes `colour(k)` of its nearest
-/// projected point `k` if that point is within its reach: its distance to
-/// its own nearest neighbour, but at least `min_reach` (projected units)
-/// and one pixel. Other pixels stay transparent.
-pub fn nearest_raster(
-    points: &[(f64, f64)],
-    size: u32,
-    min_reach: f64,
-    colour: impl Fn(usize) -> [u8; 3] + Sync,
-) -> Vec<u8> {
-    let mut rgba = vec![0u8; (size * size * 4) as usize];
-    if points.is_empty() || size == 0 {
-        return rgba;
+/// Pixel value of [`Coverage::owner`] for pixels no sample reaches.
+pub const NONE: u32 = u32::MAX;
+
+/// Side in pixels of the coverage grid of one hemisphere.
+pub const COVERAGE_SIZE: u32 = 512;
+
+/// Every sample covers the directions within this angle (degrees) that are
+/// nearer to it than to any other sample; wider gaps stay uncovered.
+pub const FILL_DEG: f64 = 4.0;
+
+/// The disk as a grid of pixels, each owned by its nearest sample (see the
+/// module docs). Pixel centres span [−RADIUS, RADIUS], row 0 at the top
+/// (y = +RADIUS). Because the projection keeps areas, every pixel stands
+/// for the same solid angle, [`Coverage::pixel_sr`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Coverage {
+    /// Pixels per side.
+    pub size: u32,
+    /// Row-major owner of every pixel (an index given with the points), or [`NONE`].
+    pub owner: Vec<u32>,
+}
+
+impl Coverage {
+    /// Assigns every pixel of a `size × size` grid to its nearest point
+    /// `ids[k]` at `points[k]`, if that point is within its reach: its
+    /// distance to its own nearest neighbour, but at least `min_reach`
+    /// (projected units) and one pixel.
+    pub fn new(points: &[(f64, f64)], ids: &[u32], size: u32, min_reach: f64) -> Coverage {
+        debug_assert_eq!(points.len(), ids.len());
+        let mut owner = vec![NONE; (size * size) as usize];
+        if points.is_empty() || size == 0 {
+            return Coverage { size, owner };
+        }
+        let pixel = 2.0 * RADIUS / size as f64;
+        let min_reach = min_reach.max(pixel);
+        // Typical spacing: the mean area per point.
+        let spacing = (std::f64::consts::PI * RADIUS * RADIUS / points.len() as f64).sqrt();
+        let grid = Grid::new(points.to_vec(), spacing.max(0.25 * min_reach));
+        // Isolated samples reach at most a few typical spacings, which also
+        // bounds the search of pixels in gaps.
+        let far = (4.0 * spacing).max(min_reach);
+        // A sample's own nearest-neighbour distance is only needed when a
+        // pixel lies beyond the minimum reach: found then, and remembered.
+        let reach: Vec<OnceLock<f64>> = (0..points.len()).map(|_| OnceLock::new()).collect();
+        let reach_of = |k: usize| {
+            *reach[k].get_or_init(|| {
+                grid.nearest(points[k].0, points[k].1, far, Some(k))
+                    .map_or(far, |(_, d)| d)
+                    .max(min_reach)
+            })
+        };
+        let rim2 = RADIUS * RADIUS;
+        owner
+            .par_chunks_mut(size as usize)
+            .enumerate()
+            .for_each(|(j, row)| {
+                let y = RADIUS - (j as f64 + 0.5) * pixel;
+                for (i, cell) in row.iter_mut().enumerate() {
+                    let x = -RADIUS + (i as f64 + 0.5) * pixel;
+                    if x * x + y * y > rim2 {
+                        continue;
+                    }
+                    if let Some((k, d)) = grid.nearest(x, y, far, None)
+                        && (d <= min_reach || d <= reach_of(k))
+                    {
+                        *cell = ids[k];
+                    }
+                }
+            });
+        Coverage { size, owner }
     }
-    let pixel = 2.0 * RADIUS / size as f64;
-    let min_reach = min_reach.max(pixel);
-    // Typical spacing: the mean area per point.
-    let spacing = (std::f64::consts::PI * RADIUS * RADIUS / points.len() as f64).sqrt();
-    let grid = Grid::new(points.to_vec(), spacing.max(0.25 * min_reach));
-    // Isolated samples reach at most a few typical spacings, which also
-    // bounds the search of pixels in gaps.
-    let far = (4.0 * spacing).max(min_reach);
-    // A sample's own nearest-neighbour distance is only needed when a pixel
-    // lies beyond the minimum reach: found then, and remembered.
-    let reach: Vec<OnceLock<f64>> = (0..points.len()).map(|_| OnceLock::new()).collect();
-    let reach_of = |k: usize| {
-        *reach[k].get_or_init(|| {
-            grid.nearest(points[k].0, points[k].1, far, Some(k))
-                .map_or(far, |(_, d)| d)
-                .max(min_reach)
-        })
-    };
-    let rim2 = (RADIUS + 0.5 * pixel) * (RADIUS + 0.5 * pixel);
-    rgba.par_chunks_mut((size * 4) as usize)
-        .enumerate()
-        .for_each(|(j, row)| {
-            let y = RADIUS - (j as f64 + 0.5) * pixel;
-            for i in 0..size as usize {
-                let x = -RADIUS + (i as f64 + 0.5) * pixel;
-                if x * x + y * y > rim2 {
-                    continue;
-                }
-                if let Some((k, d)) = grid.nearest(x, y, far, None)
-                    && (d <= min_reach || d <= reach_of(k))
-                {
-                    let c = colour(k);
-                    row[4 * i..4 * i + 3].copy_from_slice(&c);
-                    row[4 * i + 3] = 255;
-                }
+
+    /// Solid angle of one pixel, sr.
+    pub fn pixel_sr(&self) -> f64 {
+        let p = 2.0 * RADIUS / self.size as f64;
+        p * p
+    }
+
+    /// |cos| of the angle from the normal at the centre of pixel (i, j).
+    pub fn cosine_at(&self, i: u32, j: u32) -> f64 {
+        let p = 2.0 * RADIUS / self.size as f64;
+        let x = -RADIUS + (i as f64 + 0.5) * p;
+        let y = RADIUS - (j as f64 + 0.5) * p;
+        (1.0 - 0.5 * (x * x + y * y)).max(0.0)
+    }
+
+    /// The owners resampled (nearest pixel) to an `out × out` grid.
+    pub fn resampled(&self, out: u32) -> Vec<u32> {
+        if out == self.size {
+            return self.owner.clone();
+        }
+        let mut v = Vec::with_capacity((out * out) as usize);
+        for j in 0..out {
+            let sj = ((j as u64 * self.size as u64 + self.size as u64 / 2) / out as u64)
+                .min(self.size as u64 - 1) as u32;
+            for i in 0..out {
+                let si = ((i as u64 * self.size as u64 + self.size as u64 / 2) / out as u64)
+                    .min(self.size as u64 - 1) as u32;
+                v.push(self.owner[(sj * self.size + si) as usize]);
             }
-        });
-    rgba
+        }
+        v
+    }
 }
 
 #[cfg(test)]
@@ -255,11 +307,19 @@ mod tests {
             }
         }
         let size = 100;
-        let rgba = nearest_raster(&pts, size, 0.0, |_| [10, 20, 30]);
-        let alpha = |i: u32, j: u32| rgba[((j * size + i) * 4 + 3) as usize];
-        assert_eq!(alpha(25, 50), 255, "left half is covered");
-        assert_eq!(alpha(80, 50), 0, "right half is a gap");
-        assert_eq!(alpha(0, 0), 0, "corner is outside the disk");
+        let ids: Vec<u32> = (0..pts.len() as u32).collect();
+        let c = Coverage::new(&pts, &ids, size, 0.0);
+        let owner = |i: u32, j: u32| c.owner[(j * size + i) as usize];
+        assert_ne!(owner(25, 50), NONE, "left half is covered");
+        assert_eq!(owner(80, 50), NONE, "right half is a gap");
+        assert_eq!(owner(0, 0), NONE, "corner is outside the disk");
+        // Equal areas: the covered pixels add up to the covered solid angle.
+        let covered = c.owner.iter().filter(|o| **o != NONE).count() as f64 * c.pixel_sr();
+        assert!((covered - std::f64::consts::PI).abs() < 0.08, "{covered}");
+        // Resampling keeps the layout.
+        let r = c.resampled(50);
+        assert_ne!(r[(25 * 50 + 12) as usize], NONE);
+        assert_eq!(r[(25 * 50 + 40) as usize], NONE);
     }
 
     #[test]

@@ -56,11 +56,14 @@ pub struct Raster {
     pub rgba: Vec<u8>,
 }
 
+/// A raster waiting to replace its placeholder: id, upper-left pixel, image.
+type Pending = (u8, (i32, i32), Raster);
+
 /// Drawing context: the backend kind and the rasters waiting to be
 /// embedded into an SVG.
 pub struct Canvas {
     mode: Mode,
-    pending: RefCell<Vec<(u8, (i32, i32), Raster)>>,
+    pending: RefCell<Vec<Pending>>,
 }
 
 /// Turns any displayable error into the message [`PlotError::Draw`] carries.

@@ -22,6 +22,7 @@
 //! For three-channel data every plotted value (data and model) is the mean
 //! of the three channels.
 
+use crate::disk::{self, Coverage};
 use brtf_fit::{FitReport, FitResult, InputFile};
 use brtf_gonio::{Hemisphere, Measurement, Quantity};
 use brtf_model::Bsdf;
@@ -181,20 +182,35 @@ pub struct Incidence {
     pub channels: usize,
     /// Things the reader should know about this incidence's plots.
     pub warnings: Vec<String>,
-    /// The converted file, all samples (parallel to `samples`).
-    measurement: Measurement,
-    /// Solid angles of the samples, computed when first needed.
-    solid_angles: OnceLock<Vec<f64>>,
+    /// Nearest-sample grids of the front and back disks, made when first needed.
+    coverage: [OnceLock<Coverage>; 2],
 }
 
 impl Incidence {
-    /// Solid angle of every sample in sr, as the fit weighted them: the
-    /// file's Voronoi cells, else computed from the full layout (the
-    /// computation is the slow part of a dense file, so it runs on first
-    /// use, in parallel with the drawing of the maps).
-    pub fn solid_angles(&self) -> &[f64] {
-        self.solid_angles
-            .get_or_init(|| brtf_gonio::solid_angles(&self.measurement).per_sample_sr)
+    /// Every pixel of the `hemisphere`'s equal-area disk and the sample
+    /// that owns it (fitted or not; an index into `samples`), computed on
+    /// first use. The maps draw it, the hemispherical integrals sum over it.
+    pub fn coverage(&self, hemisphere: Hemisphere) -> &Coverage {
+        let slot = match hemisphere {
+            Hemisphere::Front => 0,
+            Hemisphere::Back => 1,
+        };
+        self.coverage[slot].get_or_init(|| {
+            let (ids, points): (Vec<u32>, Vec<(f64, f64)>) = self
+                .samples
+                .iter()
+                .enumerate()
+                .filter(|(_, s)| s.hemisphere() == hemisphere && s.dir.is_finite())
+                .filter(|(_, s)| !s.used() || s.data.is_finite())
+                .map(|(k, s)| (k as u32, disk::project(s.dir, hemisphere)))
+                .unzip();
+            Coverage::new(
+                &points,
+                &ids,
+                disk::COVERAGE_SIZE,
+                disk::radius_of(disk::FILL_DEG),
+            )
+        })
     }
 
     /// Model value `scale × f` (channel mean) for direction `v`.
@@ -375,9 +391,8 @@ pub fn load(
             let f = bsdf.eval(light, dir);
             let mut data = 0.0;
             let mut model = 0.0;
-            for ch in 0..channels {
-                let y = s.values[ch];
-                let mv = report.scale * f[ch];
+            for (&y, &fc) in s.values.iter().zip(&f).take(channels) {
+                let mv = report.scale * fc;
                 if removed.is_none() {
                     let e = mv - y;
                     sum_rel += e * e / (y * y + floor2);
@@ -429,8 +444,7 @@ pub fn load(
         scale: report.scale,
         channels,
         warnings,
-        measurement: m,
-        solid_angles: OnceLock::new(),
+        coverage: Default::default(),
     })
 }
 

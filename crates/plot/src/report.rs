@@ -101,12 +101,12 @@ code { font-size: 0.95em; }
 fn figure(out: &mut String, stem: &str, size: (u32, u32), caption: &str) {
     let svg = href(&format!("plots/{stem}.svg"));
     let png = href(&format!("plots/{stem}.png"));
-    let _ = write!(
+    let _ = writeln!(
         out,
         "<figure id=\"fig-{id}\"><a href=\"{png}\"><img src=\"{svg}\" width=\"{w}\" height=\"{h}\" \
-         alt=\"{alt}\" loading=\"lazy\"></a><figcaption>{caption} \
+         alt=\"{alt}\"></a><figcaption>{caption} \
          <span class=\"muted\">(<a href=\"{svg}\">SVG</a> · <a href=\"{png}\">PNG</a>)</span>\
-         </figcaption></figure>\n",
+         </figcaption></figure>",
         id = esc(stem),
         w = size.0,
         h = size.1,

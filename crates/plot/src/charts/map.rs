@@ -18,7 +18,6 @@ use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, VPos};
-use std::sync::Mutex;
 
 /// Side of one hemisphere's square in pixels.
 const DISK: u32 = 640;
@@ -26,9 +25,6 @@ const DISK: u32 = 640;
 const PANEL: u32 = 350;
 /// Extent of the map's coordinates (the rim is at √2).
 const EXTENT: f64 = RADIUS * 1.2;
-/// Every sample colours the directions within this angle (degrees) that
-/// are nearer to it than to any other sample; wider gaps stay white.
-const FILL_DEG: f64 = 4.0;
 
 /// The residual map of one incidence.
 pub struct MapChart<'a> {
@@ -40,8 +36,6 @@ pub struct MapChart<'a> {
     pub ratio: f64,
     /// The fit's RMS relative error of this incidence.
     pub rms_rel: f64,
-    /// Rasters already computed (SVG and PNG share them): hemisphere, size, RGBA.
-    cache: Mutex<Vec<(Hemisphere, u32, Vec<u8>)>>,
 }
 
 impl<'a> MapChart<'a> {
@@ -52,34 +46,7 @@ impl<'a> MapChart<'a> {
             title,
             ratio,
             rms_rel,
-            cache: Mutex::new(Vec::new()),
         }
-    }
-
-    /// The RGBA raster of one hemisphere, `size` pixels square.
-    fn raster(&self, hemisphere: Hemisphere, size: u32) -> Vec<u8> {
-        let mut cache = self.cache.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some((_, _, rgba)) = cache
-            .iter()
-            .find(|(h, s, _)| *h == hemisphere && *s == size)
-        {
-            return rgba.clone();
-        }
-        let shown: Vec<&crate::prepare::PlotSample> = self
-            .inc
-            .samples
-            .iter()
-            .filter(|s| s.hemisphere() == hemisphere && s.dir.is_finite())
-            .filter(|s| !s.used() || s.data.is_finite())
-            .collect();
-        let points: Vec<(f64, f64)> = shown
-            .iter()
-            .map(|s| disk::project(s.dir, hemisphere))
-            .collect();
-        let reach = disk::radius_of(FILL_DEG);
-        let rgba = disk::nearest_raster(&points, size, reach, |k| self.colour_of(shown[k]));
-        cache.push((hemisphere, size, rgba.clone()));
-        rgba
     }
 
     fn hemispheres(&self) -> Vec<Hemisphere> {
@@ -99,6 +66,19 @@ impl<'a> MapChart<'a> {
             MASKED
         };
         [c.0, c.1, c.2]
+    }
+
+    /// The RGBA raster of one hemisphere, `size` pixels square.
+    fn raster(&self, hemisphere: Hemisphere, size: u32) -> Vec<u8> {
+        let owner = self.inc.coverage(hemisphere).resampled(size);
+        let mut rgba = vec![0u8; owner.len() * 4];
+        for (px, &o) in rgba.chunks_exact_mut(4).zip(&owner) {
+            if o != disk::NONE {
+                px[..3].copy_from_slice(&self.colour_of(&self.inc.samples[o as usize]));
+                px[3] = 255;
+            }
+        }
+        rgba
     }
 
     fn draw_disk<DB: DrawingBackend>(

@@ -3,11 +3,13 @@
 //! transmittance) of the data against the model, and the error of every
 //! incidence's fit.
 //!
-//! ρ_dh of the data is `Σ d_i |cos θ_i| ΔΩ_i` over the fitted samples; the
-//! model's is the same sum of the model values over the same samples (so
-//! the two see the same gaps), and also the model's full integral over
-//! the hemisphere (brtf-model's [`brtf_model::albedo`]), which is what a
-//! renderer will reflect. τ_dh is the same over the back hemisphere.
+//! ρ_dh of the data is `∫ d(ω) |cos θ| dω` over the directions the fitted
+//! samples cover, with `d(ω)` the value of the nearest sample: the sum over
+//! the pixels of the map's equal-area grid ([`crate::disk::Coverage`]).
+//! The model's is the same integral of the model values at the same
+//! samples, so the two see the same gaps and masks; and the model's full
+//! integral over the hemisphere (brtf-model's [`brtf_model::albedo`]) is
+//! what a renderer will reflect. τ_dh is the same over the back hemisphere.
 
 use super::{LABEL, SMALL, TICK, fmt, lin_fmt, lin_range, theta_range, titled};
 use crate::colour::{ALERT, DATA, GUIDE, MODEL};
@@ -78,21 +80,30 @@ pub fn integrals(result: &FitResult, incs: &[Option<&Incidence>]) -> Vec<Integra
             let mut data = [None; 2];
             let mut model_same = [None; 2];
             if let Some(inc) = inc {
-                let weights = inc.solid_angles();
                 for (h, hemisphere) in [Hemisphere::Front, Hemisphere::Back].iter().enumerate() {
-                    let (mut d, mut m, mut any) = (0.0, 0.0, false);
-                    for (s, w) in inc.samples.iter().zip(weights) {
-                        if s.used() && s.hemisphere() == *hemisphere {
-                            let weight = s.dir.z.abs() * w;
-                            d += s.data * weight;
-                            m += s.model * weight;
-                            any = true;
+                    if !inc
+                        .samples
+                        .iter()
+                        .any(|s| s.used() && s.hemisphere() == *hemisphere)
+                    {
+                        continue;
+                    }
+                    let coverage = inc.coverage(*hemisphere);
+                    let (mut d, mut m) = (0.0, 0.0);
+                    for j in 0..coverage.size {
+                        for i in 0..coverage.size {
+                            let o = coverage.owner[(j * coverage.size + i) as usize];
+                            if o == crate::disk::NONE || !inc.samples[o as usize].used() {
+                                continue;
+                            }
+                            let s = &inc.samples[o as usize];
+                            let w = coverage.cosine_at(i, j);
+                            d += s.data * w;
+                            m += s.model * w;
                         }
                     }
-                    if any {
-                        data[h] = Some(d);
-                        model_same[h] = Some(m);
-                    }
+                    data[h] = Some(d * coverage.pixel_sr());
+                    model_same[h] = Some(m * coverage.pixel_sr());
                 }
             }
             Integrals {
@@ -417,6 +428,10 @@ impl Chart for ParamsChart<'_> {
     }
 }
 
+/// θ_in, then ρ_dh and τ_dh of the interpolated material and of the
+/// all-incidence fit at that θ_in.
+type CurvePoint = (f64, Option<[f64; 2]>, Option<[f64; 2]>);
+
 /// ρ_dh (and τ_dh) over θ_in: data against model.
 pub struct RhoChart<'a> {
     /// The fit.
@@ -436,7 +451,7 @@ pub struct RhoChart<'a> {
 impl RhoChart<'_> {
     /// The interpolated material's and the all-incidence fit's integrals
     /// along θ_in: `(θ, table, global)`.
-    fn curves(&self) -> Vec<(f64, Option<[f64; 2]>, Option<[f64; 2]>)> {
+    fn curves(&self) -> Vec<CurvePoint> {
         let result = self.result;
         let thetas: Vec<f64> = result.incidences.iter().map(|r| r.theta_in).collect();
         let phi = result.incidences.first().map_or(0.0, |r| r.phi_in);
@@ -608,18 +623,6 @@ impl Chart for RhoChart<'_> {
                 .msg()?
                 .label(format!("{sym} model, per-incidence fit, whole hemisphere"))
                 .legend(move |(x, y)| Circle::new((x + 10, y), 6, model_c.stroke_width(2)));
-            let same: Vec<(f64, f64)> = ints
-                .iter()
-                .filter_map(|i| i.model_same[h].map(|v| (i.theta, v)))
-                .collect();
-            chart
-                .draw_series(
-                    same.iter()
-                        .map(|&p| TriangleMarker::new(p, 6, model_c.filled())),
-                )
-                .msg()?
-                .label(format!("{sym} model, Σ over the fitted samples"))
-                .legend(move |(x, y)| TriangleMarker::new((x + 10, y), 6, model_c.filled()));
             let data: Vec<(f64, f64)> = ints
                 .iter()
                 .filter_map(|i| i.data[h].map(|v| (i.theta, v)))
@@ -630,8 +633,22 @@ impl Chart for RhoChart<'_> {
             chart
                 .draw_series(data.iter().map(|&p| Circle::new(p, 4, data_c.filled())))
                 .msg()?
-                .label(format!("{sym} data, Σ over the fitted samples"))
+                .label(format!(
+                    "{sym} data, ∫ over the directions of the fitted samples"
+                ))
                 .legend(move |(x, y)| Circle::new((x + 10, y), 4, data_c.filled()));
+            let same: Vec<(f64, f64)> = ints
+                .iter()
+                .filter_map(|i| i.model_same[h].map(|v| (i.theta, v)))
+                .collect();
+            chart
+                .draw_series(
+                    same.iter()
+                        .map(|&p| TriangleMarker::new(p, 8, model_c.stroke_width(2))),
+                )
+                .msg()?
+                .label(format!("{sym} model, same directions"))
+                .legend(move |(x, y)| TriangleMarker::new((x + 10, y), 8, model_c.stroke_width(2)));
         }
         chart
             .configure_series_labels()

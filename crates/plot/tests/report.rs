@@ -1,0 +1,156 @@
+//! report.html: every plot referenced, no broken link, the tables, the
+//! material and the provenance; a missing measurement file is a warning.
+
+use crate::common::{RAD_TEXT, TAGS, drawn, links, percent_decode, repo};
+use brtf_plot::PlotOptions;
+
+#[test]
+fn the_report_references_every_plot_and_has_no_broken_link() {
+    let d = drawn();
+    let html = std::fs::read_to_string(d.path("report.html")).unwrap();
+    let links = links(&html);
+    for l in &links {
+        if let Some(anchor) = l.strip_prefix('#') {
+            assert!(
+                html.contains(&format!("id=\"{anchor}\"")),
+                "anchor #{anchor} has no target"
+            );
+        } else if l.starts_with("data:") {
+            continue;
+        } else {
+            assert!(!l.contains("://"), "{l}: the report must work offline");
+            let path = d.dir.path().join(percent_decode(l));
+            assert!(path.is_file(), "broken link {l}");
+        }
+    }
+    for f in d
+        .written
+        .files
+        .iter()
+        .filter(|f| f.starts_with(d.path("plots")))
+    {
+        let rel = format!("plots/{}", f.file_name().unwrap().to_string_lossy());
+        assert!(
+            links.iter().any(|l| percent_decode(l) == rel),
+            "report.html does not reference {rel}"
+        );
+    }
+    // SVGs are shown, PNGs linked.
+    for tag in TAGS {
+        assert!(html.contains(&format!("src=\"plots/map-{tag}.svg\"")));
+        assert!(html.contains(&format!("href=\"plots/cut-{tag}.png\"")));
+    }
+    assert!(!html.contains("<script"), "no script needed");
+}
+
+#[test]
+fn the_report_shows_the_table_material_and_provenance() {
+    let d = drawn();
+    let html = std::fs::read_to_string(d.path("report.html")).unwrap();
+    let table = &html[html.find("<table id=\"param-table\">").expect("the table")..];
+    let table = &table[..table.find("</table>").unwrap()];
+    assert_eq!(
+        table.matches("<tr class=\"incidence\">").count(),
+        d.result.incidences.len()
+    );
+    assert_eq!(table.matches("<tr class=\"global\">").count(), 1);
+    for name in ["red", "green", "blue", "spec", "rough", "RMS rel."] {
+        assert!(table.contains(&format!("<th>{name}</th>")), "column {name}");
+    }
+    let rough = d.result.incidences[2].value("rough").unwrap();
+    assert!(table.contains(&format!("{rough:.6}")));
+    // The exported material, escaped, and linked.
+    assert!(html.contains("<pre class=\"material\">"));
+    assert!(html.contains("void metal alu-ggx"));
+    assert!(RAD_TEXT.lines().all(|l| html.contains(l)));
+    assert!(html.contains("href=\"alu-ggx.rad\""));
+    // Provenance: every input with its hash, and the command line.
+    for input in &d.result.provenance.inputs {
+        assert!(html.contains(&input.sha256));
+        assert!(html.contains(&brtf_plot::report::esc(&input.path)));
+    }
+    assert!(html.contains("brtf"));
+    assert!(html.contains("href=\"fit.json\""));
+}
+
+#[test]
+fn a_missing_measurement_file_skips_its_plots_with_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::copy(
+        repo().join("fits/alu-ggx/fit.json"),
+        dir.path().join("fit.json"),
+    )
+    .unwrap();
+    let mut result = brtf_plot::read_fit(dir.path()).unwrap();
+    // One input moved away: an absolute path that does not exist.
+    let gone = "/nonexistent/brtf-plot-test/alu-ggx:+30+0.mpc".to_string();
+    result.provenance.inputs[2].path = gone.clone();
+    result.incidences[2].source = gone.clone();
+    let options = PlotOptions {
+        search_dirs: vec![repo()],
+        ..PlotOptions::default()
+    };
+    let written = brtf_plot::write_plots(dir.path(), &result, &options).unwrap();
+    assert_eq!(written.warnings.len(), 1, "{:?}", written.warnings);
+    assert!(written.warnings[0].contains(&gone) && written.warnings[0].contains("not found"));
+    let plots = dir.path().join("plots");
+    assert!(!plots.join("map-t30.svg").exists() && !plots.join("cut-t30.png").exists());
+    assert!(plots.join("map-t15.svg").exists() && plots.join("params.png").exists());
+    let html = std::fs::read_to_string(dir.path().join("report.html")).unwrap();
+    assert!(html.contains("Read this first") && html.contains("not found"));
+    assert!(
+        !html.contains("plots/map-t30.svg"),
+        "no link to a plot not drawn"
+    );
+    for l in links(&html).iter().filter(|l| l.starts_with("plots/")) {
+        assert!(
+            dir.path().join(percent_decode(l)).is_file(),
+            "broken link {l}"
+        );
+    }
+}
+
+#[test]
+fn a_changed_file_or_a_different_selection_is_flagged() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::copy(
+        repo().join("fits/alu-ggx/fit.json"),
+        dir.path().join("fit.json"),
+    )
+    .unwrap();
+    let mut result = brtf_plot::read_fit(dir.path()).unwrap();
+    result.provenance.inputs[0].sha256 = "0".repeat(64);
+    result.incidences[1].n_points += 1;
+    result.incidences[3].rms_rel *= 1.5;
+    let options = PlotOptions {
+        search_dirs: vec![repo()],
+        ..PlotOptions::default()
+    };
+    let written = brtf_plot::write_plots(dir.path(), &result, &options).unwrap();
+    let all = written.warnings.join("\n");
+    assert!(all.contains("changed since the fit"), "{all}");
+    assert!(all.contains("the fit used"), "{all}");
+    assert!(all.contains("RMS relative error recomputed"), "{all}");
+    assert_eq!(written.warnings.len(), 3, "{all}");
+}
+
+#[test]
+fn no_incidence_is_an_error_and_a_bad_fit_json_names_its_line() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::copy(
+        repo().join("fits/alu-ggx/fit.json"),
+        dir.path().join("fit.json"),
+    )
+    .unwrap();
+    let mut result = brtf_plot::read_fit(dir.path()).unwrap();
+    result.incidences.clear();
+    let err = brtf_plot::write_plots(dir.path(), &result, &PlotOptions::default()).unwrap_err();
+    assert!(err.to_string().contains("no incidences"), "{err}");
+    std::fs::write(dir.path().join("fit.json"), "{\n  \"name\": 3\n}\n").unwrap();
+    let err = brtf_plot::read_fit(dir.path()).unwrap_err().to_string();
+    assert!(err.contains("fit.json:2:"), "{err}");
+    let err = brtf_plot::read_fit(&dir.path().join("nowhere"))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("cannot read"), "{err}");
+}

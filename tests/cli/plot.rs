@@ -1,0 +1,432 @@
+//! `brtf plot`: the data set's plots and report through the CLI, the report
+//! in a real browser, speed on a real 120 000-point scan, and errors.
+//!
+//! The browser test drives headless Chromium through chromedriver (the
+//! Debian packages `chromium` and `chromium-driver`) over the WebDriver
+//! protocol: it loads `report.html` from disk, fails on any error in the
+//! browser log (console errors and resources that failed to load), checks
+//! that the parameter table is shown and every image decoded, and saves a
+//! screenshot. Without Chromium it warns and skips, except under `CI`,
+//! where it fails.
+
+use crate::common::{brtf, repo_path, s, temp_dir};
+use serde_json::{Value, json};
+use std::io::{Read, Write};
+use std::net::{TcpListener, TcpStream};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// Fits the `data/alu-ggx` set into `dir/fit` (no plots) and returns the folder.
+fn fit_data_set(dir: &Path) -> PathBuf {
+    let out = dir.join("fit");
+    let mut args: Vec<String> = vec!["fit".into()];
+    for t in [0, 15, 30, 45, 60] {
+        args.push(s(&repo_path(&format!("data/alu-ggx/alu-ggx:+{t}+0.mpc"))).into());
+    }
+    for a in [
+        "--model",
+        "metal",
+        "--no-export",
+        "--no-plots",
+        "--out",
+        s(&out),
+    ] {
+        args.push(a.into());
+    }
+    brtf(&args, "").ok();
+    out
+}
+
+#[test]
+fn brtf_plot_draws_every_chart_and_the_report() {
+    let dir = temp_dir();
+    let fit = fit_data_set(dir.path());
+    let stdout = brtf(&["plot", s(&fit)], "").ok();
+    assert!(stdout.starts_with("brtf plot: 29 files"), "{stdout}");
+    for t in [0, 15, 30, 45, 60] {
+        for kind in ["map", "cut"] {
+            for ext in ["svg", "png"] {
+                let f = fit.join(format!("plots/{kind}-t{t}.{ext}"));
+                assert!(f.is_file(), "{} missing", f.display());
+            }
+        }
+    }
+    for stem in ["params", "rho", "rms", "cuts"] {
+        assert!(fit.join(format!("plots/{stem}.svg")).is_file());
+        assert!(fit.join(format!("plots/{stem}.png")).is_file());
+    }
+    let html = std::fs::read_to_string(fit.join("report.html")).unwrap();
+    assert!(html.contains("id=\"param-table\""));
+}
+
+#[test]
+fn brtf_plot_errors_and_warnings() {
+    let dir = temp_dir();
+    let err = brtf(&["plot", s(&dir.path().join("nowhere"))], "").err();
+    assert!(
+        err.contains("fit.json") && err.contains("cannot read"),
+        "{err}"
+    );
+    let err = brtf(&["plot", s(dir.path()), "--ratio", "0.5"], "").err();
+    assert!(err.contains("--ratio"), "{err}");
+
+    // Relative measurement paths that cannot be found from here: the maps
+    // and cuts are skipped with a warning, the rest is drawn.
+    let fit = dir.path().join("moved");
+    std::fs::create_dir(&fit).unwrap();
+    std::fs::copy(repo_path("fits/alu-ggx/fit.json"), fit.join("fit.json")).unwrap();
+    let out = Command::new(crate::common::BRTF)
+        .args(["plot", s(&fit)])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert_eq!(stderr.matches("warning").count(), 5, "{stderr}");
+    assert!(stderr.contains("measurement file not found"), "{stderr}");
+    assert!(fit.join("plots/params.svg").is_file());
+    assert!(!fit.join("plots/map-t30.svg").exists());
+    // With the repository as a search folder they are found again.
+    let stdout = Command::new(crate::common::BRTF)
+        .args(["plot", s(&fit), "--search-dir", s(&repo_path(""))])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(stdout.status.success());
+    assert!(fit.join("plots/map-t30.svg").is_file());
+}
+
+fn real_scan(name: &str) -> PathBuf {
+    let path = repo_path("../shared/data/rgl-epfl-pgII-raw").join(name);
+    assert!(
+        path.exists(),
+        "{} is missing: CI always has ../shared/data",
+        path.display()
+    );
+    path
+}
+
+#[test]
+fn plotting_a_120k_point_scan_takes_under_a_second() {
+    let dir = temp_dir();
+    let fit = dir.path().join("golden");
+    brtf(
+        &[
+            "fit",
+            s(&real_scan("golden_paper.txt")),
+            "--model",
+            "metal",
+            "--no-export",
+            "--no-plots",
+            "--out",
+            s(&fit),
+        ],
+        "",
+    )
+    .ok();
+    let text = std::fs::read_to_string(fit.join("fit.json")).unwrap();
+    let result: brtf_fit::FitResult = serde_json::from_str(&text).unwrap();
+    assert_eq!(result.incidences.len(), 1);
+    assert!(result.incidences[0].n_points > 120_000);
+    // The best of three runs: other tests share the machine.
+    let mut best = f64::INFINITY;
+    for _ in 0..3 {
+        let started = Instant::now();
+        let out = brtf(&["plot", s(&fit)], "").ok();
+        best = best.min(started.elapsed().as_secs_f64());
+        assert!(out.contains("13 files"), "{out}");
+    }
+    eprintln!(
+        "brtf plot of a {}-point incidence: {best:.3} s (best of 3)",
+        result.incidences[0].n_points
+    );
+    assert!(best < 1.0, "plotting took {best:.3} s");
+    assert!(fit.join("plots/map-t26.8421.png").is_file());
+}
+
+/// A program on `PATH`.
+fn which(names: &[&str]) -> Option<PathBuf> {
+    let path = std::env::var_os("PATH")?;
+    names.iter().find_map(|name| {
+        std::env::split_paths(&path)
+            .map(|d| d.join(name))
+            .find(|p| p.is_file())
+    })
+}
+
+/// A chromedriver process, killed when dropped.
+struct Driver {
+    child: Child,
+    port: u16,
+}
+
+impl Drop for Driver {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+impl Driver {
+    fn start(program: &Path) -> Driver {
+        let port = TcpListener::bind("127.0.0.1:0")
+            .and_then(|l| l.local_addr())
+            .map(|a| a.port())
+            .expect("a free port");
+        let child = Command::new(program)
+            .arg(format!("--port={port}"))
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap_or_else(|e| panic!("cannot start {}: {e}", program.display()));
+        let driver = Driver { child, port };
+        let deadline = Instant::now() + Duration::from_secs(20);
+        loop {
+            if let Ok(v) = driver.call("GET", "/status", None)
+                && v["value"]["ready"] == json!(true)
+            {
+                return driver;
+            }
+            assert!(Instant::now() < deadline, "chromedriver did not start");
+            std::thread::sleep(Duration::from_millis(100));
+        }
+    }
+
+    /// One WebDriver request; the JSON response.
+    fn call(&self, method: &str, path: &str, body: Option<Value>) -> Result<Value, String> {
+        let mut stream = TcpStream::connect(("127.0.0.1", self.port)).map_err(|e| e.to_string())?;
+        stream
+            .set_read_timeout(Some(Duration::from_secs(60)))
+            .map_err(|e| e.to_string())?;
+        let body = body.map(|b| b.to_string()).unwrap_or_default();
+        let request = format!(
+            "{method} {path} HTTP/1.1\r\nHost: 127.0.0.1:{}\r\nContent-Type: application/json\r\n\
+             Content-Length: {}\r\nConnection: close\r\n\r\n{body}",
+            self.port,
+            body.len()
+        );
+        stream
+            .write_all(request.as_bytes())
+            .map_err(|e| e.to_string())?;
+        // Read the header, then exactly the body (the server may keep the
+        // connection open).
+        let mut raw = Vec::new();
+        let mut buf = [0u8; 65536];
+        let split = loop {
+            if let Some(p) = raw.windows(4).position(|w| w == b"\r\n\r\n") {
+                break p;
+            }
+            let n = stream.read(&mut buf).map_err(|e| e.to_string())?;
+            if n == 0 {
+                return Err("connection closed before the header".into());
+            }
+            raw.extend_from_slice(&buf[..n]);
+        };
+        let head = String::from_utf8_lossy(&raw[..split]).to_lowercase();
+        let mut payload = raw[split + 4..].to_vec();
+        let length = head
+            .lines()
+            .find_map(|l| l.strip_prefix("content-length:"))
+            .and_then(|v| v.trim().parse::<usize>().ok());
+        let chunked = head.contains("transfer-encoding: chunked");
+        loop {
+            let done = match length {
+                Some(n) => payload.len() >= n,
+                None if chunked => payload.ends_with(b"0\r\n\r\n"),
+                None => false,
+            };
+            if done {
+                break;
+            }
+            let n = stream.read(&mut buf).map_err(|e| e.to_string())?;
+            if n == 0 {
+                break;
+            }
+            payload.extend_from_slice(&buf[..n]);
+        }
+        if chunked {
+            payload = dechunk(&payload)?;
+        }
+        serde_json::from_slice(&payload)
+            .map_err(|e| format!("{e}: {}", String::from_utf8_lossy(&payload)))
+    }
+
+    /// A request that must succeed.
+    fn must(&self, method: &str, path: &str, body: Option<Value>) -> Value {
+        let v = self
+            .call(method, path, body)
+            .unwrap_or_else(|e| panic!("{method} {path}: {e}"));
+        assert!(
+            v["value"].get("error").is_none(),
+            "{method} {path}: {}",
+            v["value"]
+        );
+        v["value"].clone()
+    }
+}
+
+fn dechunk(mut data: &[u8]) -> Result<Vec<u8>, String> {
+    let mut out = Vec::new();
+    loop {
+        let line_end = data
+            .windows(2)
+            .position(|w| w == b"\r\n")
+            .ok_or("bad chunk")?;
+        let size_text = String::from_utf8_lossy(&data[..line_end]);
+        let size = usize::from_str_radix(size_text.trim(), 16).map_err(|e| e.to_string())?;
+        data = &data[line_end + 2..];
+        if size == 0 {
+            return Ok(out);
+        }
+        out.extend_from_slice(data.get(..size).ok_or("short chunk")?);
+        data = data.get(size + 2..).ok_or("short chunk")?;
+    }
+}
+
+fn base64_decode(text: &str) -> Vec<u8> {
+    let value = |c: u8| -> u32 {
+        match c {
+            b'A'..=b'Z' => (c - b'A') as u32,
+            b'a'..=b'z' => (c - b'a' + 26) as u32,
+            b'0'..=b'9' => (c - b'0' + 52) as u32,
+            b'+' => 62,
+            b'/' => 63,
+            _ => panic!("not base64: {c}"),
+        }
+    };
+    let clean: Vec<u8> = text.bytes().filter(|c| !c.is_ascii_whitespace()).collect();
+    let mut out = Vec::new();
+    for chunk in clean.chunks(4) {
+        let digits: Vec<u32> = chunk
+            .iter()
+            .filter(|&&c| c != b'=')
+            .map(|&c| value(c))
+            .collect();
+        let mut n = 0u32;
+        for (k, d) in digits.iter().enumerate() {
+            n |= d << (18 - 6 * k);
+        }
+        for k in 0..digits.len().saturating_sub(1) {
+            out.push((n >> (16 - 8 * k)) as u8);
+        }
+    }
+    out
+}
+
+#[test]
+fn the_report_opens_in_headless_chromium_without_errors() {
+    let browser = which(&["chromium", "chromium-browser", "google-chrome"]);
+    let driver = which(&["chromedriver"]);
+    let (Some(browser), Some(driver)) = (browser, driver) else {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "CI needs Chromium and chromedriver: apt-get install -y chromium chromium-driver"
+        );
+        eprintln!(
+            "WARNING: skipping the browser test: chromium and chromedriver are not on PATH \
+             (apt-get install -y chromium chromium-driver)"
+        );
+        return;
+    };
+    let dir = temp_dir();
+    let fit = fit_data_set(dir.path());
+    brtf(&["plot", s(&fit)], "").ok();
+    let report = std::fs::canonicalize(fit.join("report.html")).unwrap();
+
+    let driver = Driver::start(&driver);
+    let profile = dir.path().join("chromium-profile");
+    let session = driver.must(
+        "POST",
+        "/session",
+        Some(json!({"capabilities": {"alwaysMatch": {
+            "browserName": "chrome",
+            "goog:chromeOptions": {
+                "binary": s(&browser),
+                "args": [
+                    "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
+                    "--no-first-run", "--disable-background-networking",
+                    "--disable-component-update", "--disable-sync", "--disable-dev-shm-usage",
+                    "--window-size=1400,1000",
+                    format!("--user-data-dir={}", s(&profile)),
+                ]
+            },
+            "goog:loggingPrefs": {"browser": "ALL"}
+        }}})),
+    );
+    let id = session["sessionId"]
+        .as_str()
+        .expect("a session id")
+        .to_string();
+    let at = |p: &str| format!("/session/{id}{p}");
+    driver.must(
+        "POST",
+        &at("/url"),
+        Some(json!({"url": format!("file://{}", s(&report))})),
+    );
+    let state = driver.must(
+        "POST",
+        &at("/execute/sync"),
+        Some(json!({"args": [], "script": "
+            const t = document.getElementById('param-table');
+            return {
+                ready: document.readyState,
+                title: document.title,
+                rows: t ? t.querySelectorAll('tbody tr').length : -1,
+                tableHeight: t ? t.getBoundingClientRect().height : 0,
+                images: document.images.length,
+                broken: Array.from(document.images)
+                    .filter(i => !i.complete || i.naturalWidth === 0)
+                    .map(i => i.getAttribute('src')),
+            };"})),
+    );
+    let log = driver.must("POST", &at("/se/log"), Some(json!({"type": "browser"})));
+    let shot = driver.must("GET", &at("/screenshot"), None);
+
+    // The check itself: a page with a missing image and a console error
+    // must show up in the log as errors.
+    let bad = fit.join("bad.html");
+    std::fs::write(
+        &bad,
+        "<!DOCTYPE html><title>bad</title><img src=\"plots/nope.svg\">\
+         <script>console.error('on purpose')</script>",
+    )
+    .unwrap();
+    let bad = std::fs::canonicalize(bad).unwrap();
+    driver.must(
+        "POST",
+        &at("/url"),
+        Some(json!({"url": format!("file://{}", s(&bad))})),
+    );
+    let bad_log = driver.must("POST", &at("/se/log"), Some(json!({"type": "browser"})));
+    let _ = driver.call("DELETE", &at(""), None);
+    let bad_errors = bad_log
+        .as_array()
+        .expect("a log")
+        .iter()
+        .filter(|e| e["level"] == json!("SEVERE"))
+        .count();
+    assert_eq!(bad_errors, 2, "the log must catch errors: {bad_log:#}");
+
+    let errors: Vec<&Value> = log
+        .as_array()
+        .expect("a log")
+        .iter()
+        .filter(|e| e["level"] == json!("SEVERE"))
+        .collect();
+    assert!(errors.is_empty(), "browser errors: {errors:#?}");
+    assert_eq!(state["ready"], json!("complete"), "{state}");
+    assert_eq!(state["title"], json!("alu-ggx: brtf fit report"), "{state}");
+    assert_eq!(state["rows"], json!(6), "5 incidences + all: {state}");
+    assert!(state["tableHeight"].as_f64().unwrap() > 50.0, "{state}");
+    assert_eq!(state["images"], json!(14), "{state}");
+    assert_eq!(state["broken"], json!([]), "{state}");
+    let png = base64_decode(shot.as_str().expect("a base64 screenshot"));
+    assert!(png.starts_with(b"\x89PNG\r\n\x1a\n") && png.len() > 10_000);
+    let saved = Path::new(env!("CARGO_TARGET_TMPDIR")).join("report-screenshot.png");
+    std::fs::write(&saved, &png).unwrap();
+    eprintln!(
+        "report.html loaded in Chromium without errors; screenshot: {}",
+        saved.display()
+    );
+}
