@@ -714,22 +714,23 @@ fn features(d: &IncidenceData, channels: usize) -> DataFeatures {
         *v.select_nth_unstable_by(k, f64::total_cmp).1
     };
     let floor = percentile(&mut front, 0.2).max(0.0);
-    // The peak: the largest value within 30° of the mirror direction.
+    // The peak: the largest value within 30° of the mirror direction
+    // (compared as cosines; the angle is taken once, for the width).
     let near: Vec<(f64, f64)> = d
         .samples
         .iter()
         .filter(|s| s.view.z > 0.0)
-        .map(|s| (s.view.angle_between(mirror), mean(s)))
-        .filter(|(delta, _)| *delta < 0.5)
+        .map(|s| (s.view.dot(mirror), mean(s)))
+        .filter(|(cos_delta, _)| *cos_delta > 0.5f64.cos())
         .collect();
     let peak = near.iter().map(|(_, y)| *y).fold(0.0, f64::max) - floor;
     let threshold = floor + peak / std::f64::consts::E;
-    let width = near
+    let widest = near
         .iter()
         .filter(|(_, y)| *y >= threshold)
-        .map(|(delta, _)| *delta)
-        .fold(0.0, f64::max)
-        .max(0.005);
+        .map(|(cos_delta, _)| *cos_delta)
+        .fold(1.0, f64::min);
+    let width = widest.clamp(-1.0, 1.0).acos().max(0.005);
     let back_median = percentile(&mut back, 0.5).max(0.0);
     DataFeatures {
         diffuse: (PI * floor).min(1.0),

@@ -131,14 +131,44 @@ impl Problem<'_> {
         }
         let (floor, kind, blocks) = (self.floor, self.kind, self.blocks);
         let floor2 = floor * floor;
-        let run_chunk = |&(b, start, end, _): &(usize, usize, usize, usize)| {
+        let mut residuals = DVector::zeros(m);
+        let mut jac = if JACOBIAN {
+            DMatrix::zeros(m, n)
+        } else {
+            DMatrix::zeros(0, 0)
+        };
+        // Hand every chunk its own rows of the residual vector and of each
+        // Jacobian column, so chunks write in place, in parallel.
+        let mut outputs: Vec<(&mut [f64], Vec<&mut [f64]>)> = Vec::with_capacity(chunks.len());
+        {
+            let mut rest = residuals.as_mut_slice();
+            let mut columns_rest: Vec<&mut [f64]> = if JACOBIAN {
+                jac.as_mut_slice().chunks_mut(m).collect()
+            } else {
+                Vec::new()
+            };
+            for &(_, start, end, _) in &chunks {
+                let rows = (end - start) * channels;
+                let (head, tail) = std::mem::take(&mut rest).split_at_mut(rows);
+                rest = tail;
+                let mut cols = Vec::with_capacity(columns_rest.len());
+                for column in columns_rest.iter_mut() {
+                    let (head, tail) = std::mem::take(column).split_at_mut(rows);
+                    *column = tail;
+                    cols.push(head);
+                }
+                outputs.push((head, cols));
+            }
+        }
+        let run_chunk = |(&(b, start, end, _), (r, cols)): (
+            &(usize, usize, usize, usize),
+            &mut (&mut [f64], Vec<&mut [f64]>),
+        )| {
             let block = &blocks[b];
-            let rows = (end - start) * channels;
-            let mut r = Vec::with_capacity(rows);
-            // Row-major n entries per row.
-            let mut j = Vec::with_capacity(if JACOBIAN { rows * n } else { 0 });
             let mut grad = Gradient::default();
             let mut sum_rel = 0.0;
+            let mut finite = true;
+            let mut row = 0;
             for i in start..end {
                 let (v, y, k) = (block.views[i], &block.values[i], &block.factors[i]);
                 let f = if JACOBIAN {
@@ -149,11 +179,12 @@ impl Problem<'_> {
                 for ch in 0..channels {
                     let model = scale * f[ch];
                     let (res, dr_dm) = residual(kind, floor, model, y[ch], k[ch]);
-                    r.push(res);
+                    r[row] = res;
+                    finite &= res.is_finite();
                     let e = model - y[ch];
                     sum_rel += e * e / (y[ch] * y[ch] + floor2);
                     if JACOBIAN {
-                        for &(target, dp_du) in &columns {
+                        for (column, &(target, dp_du)) in cols.iter_mut().zip(&columns) {
                             let dm_dp = match target {
                                 Target::Arg(a) => scale * grad.d[a][ch],
                                 Target::Gray => {
@@ -161,40 +192,33 @@ impl Problem<'_> {
                                 }
                                 Target::Scale => f[ch],
                             };
-                            j.push(dr_dm * dm_dp * dp_du);
+                            let value = dr_dm * dm_dp * dp_du;
+                            finite &= value.is_finite();
+                            column[row] = value;
                         }
                     }
+                    row += 1;
                 }
             }
-            (r, j, sum_rel)
+            (sum_rel, finite)
         };
-        let parts: Vec<(Vec<f64>, Vec<f64>, f64)> = if m >= PARALLEL_ROWS {
-            chunks.par_iter().map(run_chunk).collect()
+        let parts: Vec<(f64, bool)> = if m >= PARALLEL_ROWS {
+            chunks
+                .par_iter()
+                .zip(outputs.par_iter_mut())
+                .map(run_chunk)
+                .collect()
         } else {
-            chunks.iter().map(run_chunk).collect()
+            chunks
+                .iter()
+                .zip(outputs.iter_mut())
+                .map(run_chunk)
+                .collect()
         };
-        let mut residuals = DVector::zeros(m);
-        let mut jac = if JACOBIAN {
-            DMatrix::zeros(m, n)
-        } else {
-            DMatrix::zeros(0, 0)
-        };
-        let mut sum_rel = 0.0;
-        for (&(_, _, _, first), (r, j, s)) in chunks.iter().zip(&parts) {
-            residuals.as_mut_slice()[first..first + r.len()].copy_from_slice(r);
-            if JACOBIAN {
-                for (col, mut column) in jac.column_iter_mut().enumerate() {
-                    let column = &mut column.as_mut_slice()[first..first + r.len()];
-                    for (row, value) in column.iter_mut().enumerate() {
-                        *value = j[row * n + col];
-                    }
-                }
-            }
-            sum_rel += s;
-        }
+        drop(outputs);
         self.evaluations.set(self.evaluations.get() + 1);
-        let finite = residuals.iter().all(|x| x.is_finite())
-            && (!JACOBIAN || jac.iter().all(|x| x.is_finite()));
+        let sum_rel: f64 = parts.iter().map(|p| p.0).sum();
+        let finite = parts.iter().all(|p| p.1);
         finite.then(|| Evaluation {
             residuals,
             jacobian: JACOBIAN.then_some(jac),
