@@ -139,7 +139,7 @@ impl Problem<'_> {
         };
         // Hand every chunk its own rows of the residual vector and of each
         // Jacobian column, so chunks write in place, in parallel.
-        let mut outputs: Vec<(&mut [f64], Vec<&mut [f64]>)> = Vec::with_capacity(chunks.len());
+        let mut outputs: Vec<ChunkOutput> = Vec::with_capacity(chunks.len());
         {
             let mut rest = residuals.as_mut_slice();
             let mut columns_rest: Vec<&mut [f64]> = if JACOBIAN {
@@ -160,10 +160,7 @@ impl Problem<'_> {
                 outputs.push((head, cols));
             }
         }
-        let run_chunk = |(&(b, start, end, _), (r, cols)): (
-            &(usize, usize, usize, usize),
-            &mut (&mut [f64], Vec<&mut [f64]>),
-        )| {
+        let run_chunk = |(&(b, start, end, _), (r, cols)): (&Chunk, &mut ChunkOutput)| {
             let block = &blocks[b];
             let mut grad = Gradient::default();
             let mut sum_rel = 0.0;
@@ -226,6 +223,12 @@ impl Problem<'_> {
         })
     }
 }
+
+/// A chunk of one block: (block, first sample, end sample, first row).
+type Chunk = (usize, usize, usize, usize);
+
+/// A chunk's rows of the residual vector and of each Jacobian column.
+type ChunkOutput<'a> = (&'a mut [f64], Vec<&'a mut [f64]>);
 
 /// Residual for model `m` and measured `y` with factor `k`, and dr/dm.
 #[inline(always)]
