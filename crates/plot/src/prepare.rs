@@ -5,11 +5,11 @@
 //! data the fitter saw, rebuilt from `fit.json`:
 //!
 //! * **Conversion** (from [`InputFile::quantity`]): BSDF files are used as
-//!   they are, DSF files are divided by |cos θ_out|, raw-signal files by the
-//!   beam integral (when the fit had one) and |cos θ_out|. Without a beam
-//!   integral the data stay in the file's unit and the model is
-//!   `scale × f` with the fitted free scale ([`FitReport::scale`], 1 when
-//!   there is none).
+//!   they are, DSF files are divided by |cos θ_out|, raw-signal files by
+//!   |cos θ_out| and by the beam integral or the `--rho` scale K when the
+//!   fit had one. Without either the data stay in the file's unit and the
+//!   model is `scale × f` with the fitted free scale ([`FitReport::scale`],
+//!   1 when there is none).
 //! * **Selections**, in the order of the report's [`FitReport::gates`]:
 //!   not available, hemisphere, θ cap, beam mask, value floor. Every sample
 //!   remembers whether it was fitted and, if not, which gate removed it.
@@ -286,11 +286,20 @@ fn sha256_hex(bytes: &[u8]) -> String {
         .collect()
 }
 
-/// The beam integral the fit divided by, from the quantity text
-/// (`raw [uA] ÷ beam integral 123 ÷ |cos θ_out|`).
-fn beam_integral_of(quantity: &str) -> Option<f64> {
-    let rest = quantity.split("beam integral").nth(1)?;
+/// The number following `marker` in the quantity text, if any.
+fn number_after(quantity: &str, marker: &str) -> Option<f64> {
+    let rest = quantity.split(marker).nth(1)?;
     rest.split_whitespace().next()?.parse().ok()
+}
+
+/// What the fit divided raw signal by (besides |cos θ_out|), from the
+/// quantity text: the beam integral (`raw [uA] ÷ beam integral 123 ÷ |cos
+/// θ_out|`) or the instrument scale of `--rho` (`raw [uA] ÷ |cos θ_out| ÷ K
+/// = 3.2e-2 from --rho 0.8@30`).
+fn raw_divisor(quantity: &str) -> Option<f64> {
+    number_after(quantity, "beam integral")
+        .or_else(|| number_after(quantity, "÷ K ="))
+        .filter(|v| v.is_finite() && *v > 0.0)
 }
 
 /// Converts the file's values to what the fitter compared (see the module
@@ -299,7 +308,7 @@ fn convert(m: &Measurement, input: &InputFile) -> Result<(Measurement, DataUnit)
     let converted = match &m.quantity {
         Quantity::Bsdf => return Ok((m.clone(), DataUnit::Bsdf)),
         Quantity::Dsf => m.to_bsdf().map(|c| (c.measurement, DataUnit::Bsdf)),
-        Quantity::Raw { unit, .. } => match beam_integral_of(&input.quantity) {
+        Quantity::Raw { unit, .. } => match raw_divisor(&input.quantity) {
             Some(beam) => m.raw_to_bsdf(beam).map(|c| (c.measurement, DataUnit::Bsdf)),
             None => m
                 .raw_to_bsdf(1.0)
@@ -421,7 +430,8 @@ pub fn load(
         ));
     } else {
         let rms = (sum_rel / (n_used * channels).max(1) as f64).sqrt();
-        let tolerance = 1e-6 * report.rms_rel.abs().max(1e-9);
+        // Loose enough for numbers rounded in the quantity text.
+        let tolerance = 1e-5 * report.rms_rel.abs().max(1e-9);
         if (rms - report.rms_rel).abs() > tolerance.max(1e-9) {
             warnings.push(format!(
                 "{}: the RMS relative error recomputed from the file ({rms:.6}) differs from \
@@ -499,14 +509,18 @@ mod tests {
     }
 
     #[test]
-    fn beam_integral_is_read_from_the_quantity_text() {
+    fn the_raw_divisor_is_read_from_the_quantity_text() {
         assert_eq!(
-            beam_integral_of("raw [uA] ÷ beam integral 6.3 ÷ |cos θ_out|"),
+            raw_divisor("raw [uA] ÷ beam integral 6.3 ÷ |cos θ_out|"),
             Some(6.3)
         );
         assert_eq!(
-            beam_integral_of("raw [uA] ÷ |cos θ_out|, free scale (no beam integral)"),
+            raw_divisor("raw [uA] ÷ |cos θ_out|, free scale (no beam integral)"),
             None
+        );
+        assert_eq!(
+            raw_divisor("raw [uA] ÷ |cos θ_out| ÷ K = 3.210000e-2 from --rho 0.8@30"),
+            Some(0.0321)
         );
     }
 

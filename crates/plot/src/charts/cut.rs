@@ -6,9 +6,9 @@
 //! front normal, `x = atan2(v·m̂, v_z)` with m̂ the horizontal unit vector
 //! towards the mirror azimuth: the mirror direction is at `+θ_in`, the
 //! light at `−θ_in`, the back hemisphere beyond ±90°. Data points are the
-//! samples within a small angle of the plane (chosen so the cut holds at
-//! least 60 fitted samples, at most 3°); the model is evaluated exactly in
-//! the plane.
+//! samples within a small angle of the plane: the smallest of 0.25°–3° that
+//! gives at least 60 fitted samples and covers 90% of the 2° steps of θ_out
+//! that 3° covers. The model is evaluated exactly in the plane.
 
 use super::{LABEL, SMALL, TICK, fmt, incidence_label, log_range, titled};
 use crate::colour::{self, DATA, GUIDE, MASKED, MODEL, SHADE};
@@ -83,10 +83,27 @@ impl<'a> CutData<'a> {
             .map(|s| (plane.offset(s.dir), plane.x_of(s.dir), s))
             .filter(|(o, _, _)| *o <= TOLERANCES[TOLERANCES.len() - 1])
             .collect();
+        // The smallest tolerance with enough fitted samples that also covers
+        // (in 2° bins of x) nearly all of what the widest one covers.
+        let coverage = |t: f64| -> (usize, usize) {
+            let mut bins = std::collections::BTreeSet::new();
+            let mut count = 0;
+            for (o, x, s) in &near {
+                if *o <= t && s.used() {
+                    count += 1;
+                    bins.insert((x / 2.0).floor() as i64);
+                }
+            }
+            (count, bins.len())
+        };
+        let widest = coverage(TOLERANCES[TOLERANCES.len() - 1]).1;
         let tolerance = tolerance.unwrap_or_else(|| {
             TOLERANCES
                 .into_iter()
-                .find(|t| near.iter().filter(|(o, _, s)| *o <= *t && s.used()).count() >= ENOUGH)
+                .find(|t| {
+                    let (count, bins) = coverage(*t);
+                    count >= ENOUGH && bins as f64 >= 0.9 * widest as f64
+                })
                 .unwrap_or(TOLERANCES[TOLERANCES.len() - 1])
         });
         let back = inc.samples.iter().any(|s| s.used() && s.dir.z < 0.0);
@@ -202,7 +219,11 @@ impl Chart for CutChart<'_> {
                 .label("masked range (not fitted)")
                 .legend(|(x, y)| Rectangle::new([(x, y - 6), (x + 20, y + 6)], SHADE.filled()));
         }
-        for (x, name) in [(inc.theta_in, "mirror"), (-inc.theta_in, "light")] {
+        let mut marks = vec![(inc.theta_in, "mirror"), (-inc.theta_in, "light")];
+        if cut.range.1 > 90.0 {
+            marks.push((180.0 - inc.theta_in, "straight through"));
+        }
+        for (x, name) in marks {
             chart
                 .draw_series(DashedLineSeries::new(
                     vec![(x, lo), (x, hi)],

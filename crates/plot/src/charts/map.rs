@@ -310,12 +310,13 @@ impl<'a> MapChart<'a> {
         y += step;
         root.draw(&Circle::new((x + 11, y), 7, BLACK.stroke_width(2)))
             .msg()?;
-        root.draw(&Text::new(
-            "mirror direction".to_string(),
-            (x + 32, y),
-            left(SMALL),
-        ))
-        .msg()?;
+        let target = if self.hemispheres().contains(&Hemisphere::Back) {
+            "mirror / straight-through direction"
+        } else {
+            "mirror direction"
+        };
+        root.draw(&Text::new(target.to_string(), (x + 32, y), left(SMALL)))
+            .msg()?;
         if let Some(mask) = self.inc.beam_mask() {
             y += step;
             root.draw(&PathElement::new(
