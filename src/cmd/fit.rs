@@ -347,6 +347,18 @@ pub fn run(args: FitArgs) -> Result<()> {
             eprintln!("note: {note}");
         }
     }
+    if !args.no_plots {
+        let written = brtf_plot::write_plots(&out, &result, &brtf_plot::PlotOptions::default())
+            .with_context(|| format!("plotting into {}", out.display()))?;
+        println!(
+            "wrote {} plots and {}",
+            written.files.len().saturating_sub(1),
+            written.report.display()
+        );
+        for warning in &written.warnings {
+            eprintln!("brtf: warning: {warning}");
+        }
+    }
     Ok(())
 }
 
