@@ -16,6 +16,15 @@ export RADIANCE_BIN="$pkg/bin"
 export RAYPATH=".:$pkg/lib"
 echo "== Radiance: $("$RADIANCE_BIN/rtrace" -version 2>&1 | head -n 1)"
 
+# Headless Chromium for the report test (Debian packages; CI runs as root).
+if ! command -v chromium >/dev/null || ! command -v chromedriver >/dev/null; then
+    echo "== installing chromium and chromium-driver (Debian) for the report test"
+    sudo_cmd=""
+    [ "$(id -u)" -eq 0 ] || sudo_cmd="sudo"
+    $sudo_cmd apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq chromium chromium-driver >/dev/null
+fi
+
 echo "== cargo fmt --check"
 cargo fmt --all -- --check
 echo "== cargo clippy"
