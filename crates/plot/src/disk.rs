@@ -125,8 +125,9 @@ impl Grid {
     /// Nearest point to (x, y) other than `skip`, within `max_dist`.
     fn nearest(&self, x: f64, y: f64, max_dist: f64, skip: Option<usize>) -> Option<(usize, f64)> {
         let n = self.n as isize;
-        let cx = (((x + RADIUS) / self.cell) as isize).clamp(0, n - 1);
-        let cy = (((y + RADIUS) / self.cell) as isize).clamp(0, n - 1);
+        let (gx, gy) = ((x + RADIUS) / self.cell, (y + RADIUS) / self.cell);
+        let cx = (gx as isize).clamp(0, n - 1);
+        let cy = (gy as isize).clamp(0, n - 1);
         let mut best: Option<(usize, f64)> = None;
         let max_ring = (max_dist / self.cell).ceil() as isize + 1;
         for ring in 0..=max_ring.min(n) {
@@ -159,9 +160,15 @@ impl Grid {
                     visit(cx + ring, iy);
                 }
             }
-            // Every point in ring + 1 is at least `ring × cell` away.
+            // Every point not yet seen lies outside the block of cells
+            // visited so far (sides at the grid's edge hold nothing more).
+            let side = |inner: f64, edge: bool| if edge { f64::INFINITY } else { inner };
+            let margin = side(gx - (cx - ring) as f64, cx - ring <= 0)
+                .min(side((cx + ring + 1) as f64 - gx, cx + ring >= n - 1))
+                .min(side(gy - (cy - ring) as f64, cy - ring <= 0))
+                .min(side((cy + ring + 1) as f64 - gy, cy + ring >= n - 1));
             if let Some((_, b)) = best
-                && b.sqrt() <= ring as f64 * self.cell
+                && b.sqrt() <= margin * self.cell
             {
                 break;
             }

@@ -82,7 +82,8 @@ h3 { margin: 28px 0 6px; }
 nav a { margin-right: 14px; }
 .muted { color: #555; }
 table { border-collapse: collapse; margin: 10px 0; font-size: 0.92em; }
-th, td { border: 1px solid #ccc; padding: 3px 8px; text-align: right; vertical-align: top; }
+th, td { border: 1px solid #ccc; padding: 3px 8px; text-align: right; vertical-align: top; white-space: nowrap; }
+td.l { white-space: normal; }
 th { background: #f1f1f1; }
 td.l, th.l { text-align: left; }
 tr.global td { background: #f8f8f8; font-weight: 600; }
