@@ -301,7 +301,7 @@ pub fn run(args: FitArgs) -> Result<()> {
                 .input
                 .quantity
                 .replace(", free scale (no beam integral)", "");
-            p.input.quantity = format!("{base} ÷ K = {k:.6e} from --rho {rho}@{theta}");
+            p.input.quantity = format!("{base} ÷ K = {k:e} from --rho {rho}@{theta}");
         }
         config.free_scale = false;
         (reports, global) = pool.install(|| fit_all(&prepared, &config))?;
