@@ -183,8 +183,9 @@ fn gauss_legendre() -> &'static [(f64, f64)] {
     NODES.get_or_init(|| gauss_legendre_rule(PANEL_ORDER))
 }
 
-/// The n-point Gauss–Legendre rule, by Newton iteration on P_n.
-pub(crate) fn gauss_legendre_rule(n: usize) -> Vec<(f64, f64)> {
+/// The n-point Gauss–Legendre rule on [−1, 1] as (node, weight) pairs, by
+/// Newton iteration on the Legendre polynomial P_n.
+pub fn gauss_legendre_rule(n: usize) -> Vec<(f64, f64)> {
     let mut rule = Vec::with_capacity(n);
     for i in 0..n {
         let mut x = (PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();

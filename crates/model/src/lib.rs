@@ -30,7 +30,7 @@ mod kind;
 mod material;
 mod options;
 
-pub use albedo::{Albedo, albedo};
+pub use albedo::{Albedo, albedo, gauss_legendre_rule};
 pub use bsdf::{Bsdf, Gradient, Rgb};
 pub use kind::{MaterialKind, Variant};
 pub use material::{FTINY, MAX_ARGS, Material, ModelError};

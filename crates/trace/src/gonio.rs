@@ -313,7 +313,7 @@ pub fn quadrature_cone(
         return;
     }
     let frame = crate::frame::Frame::from_z(axis);
-    for (x, w) in gauss_legendre(radial) {
+    for (x, w) in brtf_model::gauss_legendre_rule(radial) {
         let delta = 0.5 * a * (x + 1.0);
         let (sd, cd) = delta.sin_cos();
         let wr = 0.5 * a * w * sd;
@@ -373,27 +373,3 @@ pub fn in_cone(axis: DVec3, a: f64, dir: DVec3) -> bool {
     1.0 - axis.dot(dir) <= one_minus_cos(a)
 }
 
-/// The n-point Gauss–Legendre rule on [−1, 1].
-pub fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
-    let mut rule = Vec::with_capacity(n);
-    for i in 0..n {
-        let mut x = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-        let mut dp = 1.0;
-        for _ in 0..100 {
-            let (mut p0, mut p1) = (1.0, x);
-            for k in 2..=n {
-                let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
-                p0 = p1;
-                p1 = p2;
-            }
-            dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
-            let step = p1 / dp;
-            x -= step;
-            if step.abs() < 1e-15 {
-                break;
-            }
-        }
-        rule.push((x, 2.0 / ((1.0 - x * x) * dp * dp)));
-    }
-    rule
-}
