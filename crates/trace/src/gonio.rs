@@ -372,4 +372,3 @@ pub fn cone_average(
 pub fn in_cone(axis: DVec3, a: f64, dir: DVec3) -> bool {
     1.0 - axis.dot(dir) <= one_minus_cos(a)
 }
-

@@ -10,9 +10,9 @@
 //! 0.01/(number of tests).
 
 use crate::common::chi2_p_value;
+use brtf_model::gauss_legendre_rule as gauss_legendre;
 use brtf_trace::Rng;
 use brtf_trace::frame::Frame;
-use brtf_model::gauss_legendre_rule as gauss_legendre;
 use brtf_trace::sampling::{
     ReflectionLobe, TransmissionLobe, cosine_hemisphere, cosine_hemisphere_pdf, uniform_cone,
     uniform_cone_pdf,
