@@ -86,6 +86,27 @@ struct ViewCoefficients {
     diffuse: f64,
 }
 
+/// What `f(l, v)` takes from the two directions alone: everything that
+/// does not depend on the material's arguments. Made by
+/// [`Bsdf::geometry`] and valid for every [`Bsdf`] of the same type,
+/// orientation and options, so a fitter can compute it once per sample
+/// and evaluate many parameter sets with [`Bsdf::eval_geometry`].
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Geometry {
+    /// cos θ of the light once the surface faces the viewer: > 0 reflection,
+    /// < 0 transmission.
+    light_cosine: f64,
+    /// cos θ of the viewer, clamped as rtrace does.
+    view_cosine: f64,
+    /// The lobe's normalisation (reflection) or geometry factor (transmission).
+    lobe_factor: f64,
+    /// Exponent numerators along û and v̂ (isotropic types use `x_u` only).
+    x_u: f64,
+    x_v: f64,
+    /// Anisotropic transmission: `sqrt(|cos θ_l| / cos θ_v)` for rtrace's cut-off.
+    cutoff_factor: f64,
+}
+
 impl Bsdf {
     /// Prepares `material` for evaluation under `options`.
     pub fn new(material: &Material, options: &EvalOptions) -> Bsdf {
@@ -187,7 +208,7 @@ impl Bsdf {
     #[inline]
     pub fn eval(&self, l: DVec3, v: DVec3) -> Rgb {
         let mut unused = Gradient::default();
-        self.eval_impl::<false>(l, v, &mut unused)
+        self.eval_impl::<false>(&self.geometry(l, v), &mut unused)
     }
 
     /// BSDF and its gradient with respect to every real argument.
@@ -195,7 +216,44 @@ impl Bsdf {
     #[inline]
     pub fn eval_with_gradient(&self, l: DVec3, v: DVec3, grad: &mut Gradient) -> Rgb {
         *grad = Gradient::default();
-        self.eval_impl::<true>(l, v, grad)
+        self.eval_impl::<true>(&self.geometry(l, v), grad)
+    }
+
+    /// The argument-free part of `f(l, v)`; see [`Geometry`].
+    #[inline(always)]
+    pub fn geometry(&self, l: DVec3, v: DVec3) -> Geometry {
+        // Turn the surface towards the viewer.
+        let (l, v) = if v.z < 0.0 {
+            (DVec3::new(l.x, l.y, -l.z), DVec3::new(v.x, v.y, -v.z))
+        } else {
+            (l, v)
+        };
+        let mut g = Geometry {
+            light_cosine: l.z,
+            view_cosine: v.z.max(MIN_VIEW_COSINE),
+            ..Geometry::default()
+        };
+        if g.light_cosine > FTINY {
+            self.reflection_geometry(l, v, &mut g);
+        } else if g.light_cosine < -FTINY {
+            self.transmission_geometry(l, v, &mut g);
+        }
+        g
+    }
+
+    /// `f` for directions prepared by [`Bsdf::geometry`] (of this or any
+    /// `Bsdf` with the same type, orientation and options).
+    #[inline]
+    pub fn eval_geometry(&self, g: &Geometry) -> Rgb {
+        let mut unused = Gradient::default();
+        self.eval_impl::<false>(g, &mut unused)
+    }
+
+    /// `f` and its gradient for directions prepared by [`Bsdf::geometry`].
+    #[inline]
+    pub fn eval_geometry_with_gradient(&self, g: &Geometry, grad: &mut Gradient) -> Rgb {
+        *grad = Gradient::default();
+        self.eval_impl::<true>(g, grad)
     }
 
     fn view_coefficients(&self, view_cosine: f64) -> ViewCoefficients {
@@ -248,15 +306,9 @@ impl Bsdf {
     }
 
     #[inline(always)]
-    fn eval_impl<const GRAD: bool>(&self, l: DVec3, v: DVec3, grad: &mut Gradient) -> Rgb {
-        // Turn the surface towards the viewer.
-        let (l, v) = if v.z < 0.0 {
-            (DVec3::new(l.x, l.y, -l.z), DVec3::new(v.x, v.y, -v.z))
-        } else {
-            (l, v)
-        };
-        let view_cosine = v.z.max(MIN_VIEW_COSINE);
-        let light_cosine = l.z;
+    fn eval_impl<const GRAD: bool>(&self, g: &Geometry, grad: &mut Gradient) -> Rgb {
+        let view_cosine = g.view_cosine;
+        let light_cosine = g.light_cosine;
         let view = self.view_coefficients(view_cosine);
         let t = view.transmitted;
         let wrong_side = if light_cosine < 0.0 {
@@ -279,16 +331,7 @@ impl Bsdf {
         let lay = self.layout;
         let c = self.color;
         if light_cosine > FTINY {
-            self.add_reflection::<GRAD>(
-                l,
-                v,
-                light_cosine,
-                view_cosine,
-                &view,
-                light_fresnel,
-                &mut f,
-                grad,
-            );
+            self.add_reflection::<GRAD>(g, &view, light_fresnel, &mut f, grad);
         } else if light_cosine < -FTINY {
             // Diffuse transmission C·Td/π.
             // (td > 0 only for the transmitting types, which have both indices.)
@@ -309,16 +352,7 @@ impl Bsdf {
                 }
             }
             if !self.pure && ts > FTINY {
-                self.add_transmission::<GRAD>(
-                    l,
-                    v,
-                    -light_cosine,
-                    view_cosine,
-                    &view,
-                    ts,
-                    &mut f,
-                    grad,
-                );
+                self.add_transmission::<GRAD>(g, &view, ts, &mut f, grad);
             }
         }
         f
@@ -328,10 +362,7 @@ impl Bsdf {
     #[inline(always)]
     fn add_reflection<const GRAD: bool>(
         &self,
-        l: DVec3,
-        v: DVec3,
-        light_cosine: f64,
-        view_cosine: f64,
+        g: &Geometry,
         view: &ViewCoefficients,
         light_fresnel: f64,
         f: &mut Rgb,
@@ -343,7 +374,7 @@ impl Bsdf {
         // Ward 1992 metal: the Fresnel estimate acts on each channel's
         // coloured specularity, and diffuse is C (1 - that).
         let ward_e = if ward_metal {
-            (-6.0 * view_cosine).exp()
+            (-6.0 * g.view_cosine).exp()
         } else {
             0.0
         };
@@ -381,7 +412,7 @@ impl Bsdf {
         if self.pure || !spec_on {
             return;
         }
-        let lobe = self.reflection_lobe(l, v, light_cosine, view_cosine);
+        let lobe = self.reflection_lobe(g);
         if !lobe.passes_cutoff {
             return;
         }
@@ -410,16 +441,13 @@ impl Bsdf {
     #[inline(always)]
     fn add_transmission<const GRAD: bool>(
         &self,
-        l: DVec3,
-        v: DVec3,
-        light_cosine: f64,
-        view_cosine: f64,
+        g: &Geometry,
         view: &ViewCoefficients,
         ts: f64,
         f: &mut Rgb,
         grad: &mut Gradient,
     ) {
-        let lobe = self.transmission_lobe(l, v, light_cosine, view_cosine);
+        let lobe = self.transmission_lobe(g);
         if !lobe.passes_cutoff {
             return;
         }
@@ -448,37 +476,29 @@ impl Bsdf {
         }
     }
 
-    /// The reflected lobe (specularity not included) and its derivatives
-    /// with respect to the squared widths along û and v̂.
+    /// The reflected lobe's direction factors: normalisation and exponent
+    /// numerators (`ci`, `co`: light and view cosines).
     #[inline(always)]
-    fn reflection_lobe(&self, l: DVec3, v: DVec3, ci: f64, co: f64) -> Lobe {
+    fn reflection_geometry(&self, l: DVec3, v: DVec3, g: &mut Geometry) {
+        let (ci, co) = (g.light_cosine, g.view_cosine);
         let h = l + v;
         let hn = h.z;
         let hh = h.dot(h);
         let inv_hn2 = 1.0 / (hn * hn);
         let variant = self.options.variant;
-        let norm = match variant {
+        g.lobe_factor = match variant {
             Variant::Radiance => hh * inv_hn2 * inv_hn2 * (1.0 / PI),
             Variant::Manual2004 => 1.0 / (4.0 * PI * ci * co),
             Variant::Ward1992 => 1.0 / (4.0 * PI * (ci * co).sqrt()),
         };
-        let cutoff = variant == Variant::Radiance;
         if !self.anisotropic {
-            let inv_w = self.reflect_inv_width.0;
-            let x = match variant {
+            g.x_u = match variant {
                 Variant::Ward1992 => 2.0 - 2.0 * hn / hh.sqrt(),
                 // tan²θ_h
                 _ => hh * inv_hn2 - 1.0,
             };
-            let value = norm * (-x * inv_w).exp() * inv_w;
-            return Lobe {
-                value,
-                d_width_u: value * (x * inv_w - 1.0) * inv_w,
-                d_width_v: 0.0,
-                passes_cutoff: !cutoff || value > FTINY,
-            };
+            return;
         }
-        let (inv_wu, inv_wv) = self.reflect_inv_width;
         let hu = h.dot(self.frame_u);
         let hv = h.dot(self.frame_v);
         let scale = match variant {
@@ -486,37 +506,22 @@ impl Bsdf {
             Variant::Ward1992 => 2.0 / (hh * (1.0 + hn / hh.sqrt())),
             _ => inv_hn2,
         };
-        let (xu, xv) = (hu * hu * scale, hv * hv * scale);
-        let value = norm * (-(xu * inv_wu + xv * inv_wv)).exp() * (inv_wu * inv_wv).sqrt();
-        Lobe {
-            value,
-            d_width_u: value * (xu * inv_wu - 0.5) * inv_wu,
-            d_width_v: value * (xv * inv_wv - 0.5) * inv_wv,
-            passes_cutoff: !cutoff || value > FTINY,
-        }
+        g.x_u = hu * hu * scale;
+        g.x_v = hv * hv * scale;
     }
 
-    /// The transmitted lobe (C·Ts not included); `ci` is |cos θ_light|.
+    /// The transmitted lobe's direction factors.
     #[inline(always)]
-    fn transmission_lobe(&self, l: DVec3, v: DVec3, ci: f64, co: f64) -> Lobe {
-        let bu = self.alpha2_u + self.transmit_widening;
-        let bv = self.alpha2_v + self.transmit_widening;
-        let geometry = match self.options.variant {
+    fn transmission_geometry(&self, l: DVec3, v: DVec3, g: &mut Geometry) {
+        let (ci, co) = (-g.light_cosine, g.view_cosine);
+        g.lobe_factor = match self.options.variant {
             Variant::Manual2004 => 1.0 / (ci * co),
             _ => 1.0 / (ci * co).sqrt(),
         };
-        let radiance = self.options.variant == Variant::Radiance;
         if !self.anisotropic {
             // 2 - 2 t·l with t = -v.
-            let x = 2.0 + 2.0 * v.dot(l);
-            let g = (-x / bu).exp() / (PI * bu);
-            let value = g * geometry;
-            return Lobe {
-                value,
-                d_width_u: value * (x / bu - 1.0) / bu,
-                d_width_v: 0.0,
-                passes_cutoff: !radiance || g > FTINY,
-            };
+            g.x_u = 2.0 + 2.0 * v.dot(l);
+            return;
         }
         let c = l + v;
         let cc = c.dot(c);
@@ -525,18 +530,65 @@ impl Bsdf {
         } else {
             cc
         };
-        let (xu, xv) = if s2 > FTINY * FTINY {
+        if s2 > FTINY * FTINY {
             let cu = c.dot(self.frame_u);
             let cv = c.dot(self.frame_v);
-            (cu * cu / s2, cv * cv / s2)
-        } else {
-            (0.0, 0.0)
-        };
+            g.x_u = cu * cu / s2;
+            g.x_v = cv * cv / s2;
+        }
+        g.cutoff_factor = (ci / co).sqrt();
+    }
+
+    /// The reflected lobe (specularity not included) and its derivatives
+    /// with respect to the squared widths along û and v̂.
+    #[inline(always)]
+    fn reflection_lobe(&self, g: &Geometry) -> Lobe {
+        let cutoff = self.options.variant == Variant::Radiance;
+        if !self.anisotropic {
+            let inv_w = self.reflect_inv_width.0;
+            let x = g.x_u;
+            let value = g.lobe_factor * (-x * inv_w).exp() * inv_w;
+            return Lobe {
+                value,
+                d_width_u: value * (x * inv_w - 1.0) * inv_w,
+                d_width_v: 0.0,
+                passes_cutoff: !cutoff || value > FTINY,
+            };
+        }
+        let (inv_wu, inv_wv) = self.reflect_inv_width;
+        let (xu, xv) = (g.x_u, g.x_v);
+        let value = g.lobe_factor * (-(xu * inv_wu + xv * inv_wv)).exp() * (inv_wu * inv_wv).sqrt();
+        Lobe {
+            value,
+            d_width_u: value * (xu * inv_wu - 0.5) * inv_wu,
+            d_width_v: value * (xv * inv_wv - 0.5) * inv_wv,
+            passes_cutoff: !cutoff || value > FTINY,
+        }
+    }
+
+    /// The transmitted lobe (C·Ts not included).
+    #[inline(always)]
+    fn transmission_lobe(&self, g: &Geometry) -> Lobe {
+        let bu = self.alpha2_u + self.transmit_widening;
+        let bv = self.alpha2_v + self.transmit_widening;
+        let radiance = self.options.variant == Variant::Radiance;
+        if !self.anisotropic {
+            let x = g.x_u;
+            let lobe = (-x / bu).exp() / (PI * bu);
+            let value = lobe * g.lobe_factor;
+            return Lobe {
+                value,
+                d_width_u: value * (x / bu - 1.0) / bu,
+                d_width_v: 0.0,
+                passes_cutoff: !radiance || lobe > FTINY,
+            };
+        }
+        let (xu, xv) = (g.x_u, g.x_v);
         let e = (-(xu / bu + xv / bv)).exp();
         let root = (bu * bv).sqrt();
-        let value = e * geometry / (PI * root);
+        let value = e * g.lobe_factor / (PI * root);
         // rtrace applies its cut-off after multiplying by sqrt(|ci|/co).
-        let cutoff_value = e * (ci / (co * bu * bv)).sqrt() / PI;
+        let cutoff_value = e * g.cutoff_factor / (PI * root);
         Lobe {
             value,
             d_width_u: value * (xu / bu - 0.5) / bu,

@@ -77,6 +77,33 @@ proptest! {
         }
     }
 
+    /// A geometry prepared by one `Bsdf` serves any other of the same type,
+    /// orientation and options: `eval_geometry` equals `eval` bit for bit,
+    /// with and without the gradient.
+    #[test]
+    fn prepared_geometry_serves_other_arguments(
+        kind in kinds(),
+        variant in variants(),
+        u in prop::array::uniform8(0.0f64..1.0),
+        w in prop::array::uniform8(0.0f64..1.0),
+        theta_in in 0.0f64..89.0, phi_in in 0.0f64..360.0,
+        theta_out in 0.0f64..180.0, phi_out in 0.0f64..360.0,
+        omega in prop::sample::select(vec![0.0, 6.8e-5]),
+    ) {
+        let options = EvalOptions { variant, source_omega: omega, ..EvalOptions::default() };
+        let first = material_from(kind, &u);
+        let second = first.with_args(material_from(kind, &w).args()).unwrap();
+        let (l, v) = (direction(theta_in, phi_in), direction(theta_out, phi_out));
+        let geometry = Bsdf::new(&first, &options).geometry(l, v);
+        let bsdf = Bsdf::new(&second, &options);
+        prop_assert_eq!(bsdf.eval_geometry(&geometry), bsdf.eval(l, v));
+        let (mut g1, mut g2) = (Gradient::default(), Gradient::default());
+        let a = bsdf.eval_geometry_with_gradient(&geometry, &mut g1);
+        let b = bsdf.eval_with_gradient(l, v, &mut g2);
+        prop_assert_eq!(a, b);
+        prop_assert_eq!(g1, g2);
+    }
+
     /// The reflection part of the radiance variant is reciprocal: f(l,v) = f(v,l).
     /// (Except where rtrace's Fresnel estimate is on, which is symmetric too.)
     #[test]
