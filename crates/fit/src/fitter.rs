@@ -5,13 +5,13 @@
 
 use crate::data::{GateReport, IncidenceData};
 use crate::params::{MIN_ROUGHNESS, ParamMap, Target};
-use crate::problem::{Block, Problem, ResidualKind};
-use brtf_model::{EvalOptions, MaterialKind};
+use crate::problem::{Block, Compressed, Problem, ResidualKind};
+use brtf_model::{Bsdf, EvalOptions, MaterialKind};
 use glam::DVec3;
 use levenberg_marquardt::{LevenbergMarquardt, TerminationReason};
 use nalgebra::DVector;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
-use std::cell::Cell;
 use std::f64::consts::PI;
 use std::time::Instant;
 
@@ -376,48 +376,51 @@ fn fit_many(
     let map = ParamMap::new(config.kind, gray, config.free_scale);
     let orientation = DVec3::from_array(config.orientation);
     let floor = config.floor.unwrap_or_else(|| auto_floor(data, channels));
-    let mut blocks: Vec<Block> = data.iter().map(|d| make_block(d, data.len() > 1)).collect();
+    // Light and views are fixed, so the argument-free part of the BSDF is
+    // computed once per sample, by a Bsdf of the fitted type, orientation
+    // and options (the arguments do not matter: the logistic mid-point).
+    let reference = Problem::new(&map, config, orientation, &[], channels, floor)
+        .physical(&DVector::zeros(map.len()))
+        .map(|(_, _, material, _)| Bsdf::new(&material, &config.options))
+        .ok_or_else(|| FitError::Failed {
+            origin: label.into(),
+            reason: "no valid material at the parameters' mid-points".into(),
+        })?;
+    let mut blocks: Vec<Block> = data
+        .iter()
+        .map(|d| make_block(d, channels, &reference))
+        .collect();
     for b in &mut blocks {
         b.set_factors(config.residual, floor);
     }
     let n_points: usize = blocks.iter().map(Block::len).sum();
-    let evaluations = Cell::new(0usize);
-    let solve = |blocks: &[Block], u0: DVector<f64>, patience: usize| {
-        let problem = Problem {
-            map: &map,
-            options: config.options,
-            orientation,
-            blocks,
-            channels,
-            kind: config.residual,
-            floor,
-            u: u0.clone(),
-            evaluations: Cell::new(0),
-            cached_jacobian: Default::default(),
-        };
+    let mut evaluations = 0;
+    let solve = |blocks: &[Block], u0: DVector<f64>, patience: usize| -> Solved {
+        let problem = Problem::new(&map, config, orientation, blocks, channels, floor);
+        let mut problem = problem;
+        problem.u = u0.clone();
         let (problem, report) = LevenbergMarquardt::new()
             .with_ftol(1e-10)
             .with_xtol(1e-10)
             .with_gtol(1e-14)
             .with_patience(patience)
             .minimize(problem);
-        evaluations.set(evaluations.get() + problem.evaluations.get());
         // After User/Numerical stops the problem holds the rejected trial
         // point; fall back to the start then.
-        if matches!(
+        let failed = matches!(
             report.termination,
             TerminationReason::User(_) | TerminationReason::Numerical(_)
-        ) {
-            let cost = problem
-                .residual_vector(&u0)
-                .map_or(f64::INFINITY, |r| 0.5 * r.norm_squared());
-            (u0, cost, report.termination)
-        } else {
-            (
-                problem.u.clone(),
-                report.objective_function,
-                report.termination,
-            )
+        );
+        let u = if failed { u0 } else { problem.u.clone() };
+        let at_solution = problem.evaluated(&u);
+        Solved {
+            cost: at_solution
+                .as_ref()
+                .map_or(f64::INFINITY, |c| 0.5 * c.residuals.norm_squared()),
+            u,
+            termination: report.termination,
+            evaluations: problem.evaluations.get(),
+            at_solution,
         }
     };
 
@@ -430,23 +433,30 @@ fn fit_many(
             .iter()
             .map(|b| subsample(b, SUBSAMPLE / blocks.len().max(1)))
             .collect();
-        for (rough, u0) in &starts {
-            let (u, cost, _) = solve(&sub, u0.clone(), 60);
+        // The starts are independent: run them in parallel, then pick the
+        // lowest cost (the first on ties), so the choice is deterministic.
+        let ends: Vec<Solved> = starts
+            .par_iter()
+            .map(|(_, u0)| solve(&sub, u0.clone(), 60))
+            .collect();
+        for ((rough, _), end) in starts.iter().zip(ends) {
+            evaluations += end.evaluations;
             records.push(StartRecord {
                 rough: *rough,
-                cost,
+                cost: end.cost,
             });
-            if best.as_ref().is_none_or(|(_, c)| cost < *c) {
-                best = Some((u, cost));
+            if best.as_ref().is_none_or(|(_, c)| end.cost < *c) {
+                best = Some((end.u, end.cost));
             }
         }
     }
     let u_start = best.map_or_else(|| starts[0].1.clone(), |(u, _)| u);
-    let (mut u, mut cost, mut termination) = solve(&blocks, u_start, 200);
-    if !cost.is_finite() {
+    let mut solved = solve(&blocks, u_start, 200);
+    evaluations += solved.evaluations;
+    if !solved.cost.is_finite() {
         return Err(FitError::Failed {
             origin: label.into(),
-            reason: format!("no finite residuals ({termination:?})"),
+            reason: format!("no finite residuals ({:?})", solved.termination),
         });
     }
 
@@ -454,19 +464,8 @@ fn fit_many(
     if config.loss != RobustLoss::None {
         let base = blocks.clone();
         for _ in 0..5 {
-            let problem = Problem {
-                map: &map,
-                options: config.options,
-                orientation,
-                blocks: &base,
-                channels,
-                kind: config.residual,
-                floor,
-                u: u.clone(),
-                evaluations: Cell::new(0),
-                cached_jacobian: Default::default(),
-            };
-            let Some(r) = problem.residual_vector(&u) else {
+            let problem = Problem::new(&map, config, orientation, &base, channels, floor);
+            let Some(r) = problem.residual_vector(&solved.u) else {
                 break;
             };
             let sigma = robust_sigma(&r);
@@ -490,39 +489,36 @@ fn fit_many(
                 }
                 b.set_factors(config.residual, floor);
             }
-            let previous = u.clone();
-            (u, cost, termination) = solve(&blocks, u, 200);
-            if (&u - &previous).amax() < 1e-8 {
+            let previous = solved.u.clone();
+            solved = solve(&blocks, previous.clone(), 200);
+            evaluations += solved.evaluations;
+            if (&solved.u - &previous).amax() < 1e-8 {
                 break;
             }
         }
     }
 
-    let problem = Problem {
-        map: &map,
-        options: config.options,
-        orientation,
-        blocks: &blocks,
-        channels,
-        kind: config.residual,
-        floor,
-        u: u.clone(),
-        evaluations: Cell::new(0),
-        cached_jacobian: Default::default(),
-    };
+    let Solved {
+        u,
+        cost,
+        termination,
+        at_solution,
+        ..
+    } = solved;
+    let problem = Problem::new(&map, config, orientation, &blocks, channels, floor);
     let (p, dp, material, scale) = problem.physical(&u).ok_or_else(|| FitError::Failed {
         origin: label.into(),
         reason: "the solution is not a valid material".into(),
     })?;
     let m_res = problem.n_residuals();
-    let final_pass = problem
-        .evaluate::<true>(&u)
-        .ok_or_else(|| FitError::Failed {
-            origin: label.into(),
-            reason: "non-finite residuals or Jacobian at the solution".into(),
-        })?;
+    // The solution's pass from the optimiser's own history.
+    let final_pass = at_solution.ok_or_else(|| FitError::Failed {
+        origin: label.into(),
+        reason: "non-finite residuals or Jacobian at the solution".into(),
+    })?;
     let rms_rel = final_pass.rms_rel;
-    let jacobian = final_pass.jacobian.expect("requested");
+    // JᵀJ = RᵀR for the compressed Jacobian [R; 0].
+    let jacobian = final_pass.jacobian;
     let dof = m_res.saturating_sub(map.len()).max(1) as f64;
     let s2 = 2.0 * cost / dof;
     let stderr_u = (jacobian.transpose() * &jacobian)
@@ -596,11 +592,22 @@ fn fit_many(
         cost,
         floor,
         termination: Termination::from_lm(&termination),
-        evaluations: evaluations.get(),
+        evaluations,
         elapsed_ms: started.elapsed().as_secs_f64() * 1e3,
         starts: records,
         warnings,
     })
+}
+
+/// Where one Levenberg-Marquardt run ended.
+struct Solved {
+    u: DVector<f64>,
+    /// ½‖r‖² at `u` (infinite when it could not be evaluated).
+    cost: f64,
+    termination: TerminationReason,
+    evaluations: usize,
+    /// The compressed problem at `u`.
+    at_solution: Option<Compressed>,
 }
 
 /// 1.4826 × the median absolute residual, a robust standard deviation.
@@ -614,17 +621,32 @@ fn robust_sigma(r: &DVector<f64>) -> f64 {
 /// Normalised weights: each block's weights average 1, so the cost reads
 /// like an unweighted sum and (for the global fit) every incidence counts
 /// the same.
-fn make_block(d: &IncidenceData, _global: bool) -> Block {
+fn make_block(d: &IncidenceData, channels: usize, reference: &Bsdf) -> Block {
     let total: f64 = d.samples.iter().map(|s| s.weight.max(0.0)).sum();
     let mean = if total > 0.0 {
         total / d.samples.len() as f64
     } else {
         1.0
     };
+    let light = d.light();
+    let geometry = if d.samples.len() >= PARALLEL_SAMPLES {
+        d.samples
+            .par_iter()
+            .map(|s| reference.geometry(light, s.view))
+            .collect()
+    } else {
+        d.samples
+            .iter()
+            .map(|s| reference.geometry(light, s.view))
+            .collect()
+    };
     Block {
-        light: d.light(),
-        views: d.samples.iter().map(|s| s.view).collect(),
-        values: d.samples.iter().map(|s| s.value).collect(),
+        geometry,
+        values: d
+            .samples
+            .iter()
+            .flat_map(|s| s.value.into_iter().take(channels))
+            .collect(),
         sqrt_weights: d
             .samples
             .iter()
@@ -637,21 +659,34 @@ fn make_block(d: &IncidenceData, _global: bool) -> Block {
             })
             .collect(),
         factors: Vec::new(),
+        channels,
     }
 }
+
+/// Blocks with at least this many samples prepare their geometry in parallel.
+const PARALLEL_SAMPLES: usize = 16_384;
 
 /// Every k-th sample, keeping the block's weight total.
 fn subsample(b: &Block, target: usize) -> Block {
     let step = (b.len() / target.max(1)).max(1);
-    let pick = |i: &usize| i.is_multiple_of(step);
-    let idx: Vec<usize> = (0..b.len()).filter(pick).collect();
+    let channels = b.channels;
+    let idx: Vec<usize> = (0..b.len()).step_by(step).collect();
     let w = (step as f64).sqrt();
+    let rows = |v: &[f64], scale: f64| -> Vec<f64> {
+        idx.iter()
+            .flat_map(|&i| {
+                v[i * channels..(i + 1) * channels]
+                    .iter()
+                    .map(move |x| x * scale)
+            })
+            .collect()
+    };
     Block {
-        light: b.light,
-        views: idx.iter().map(|&i| b.views[i]).collect(),
-        values: idx.iter().map(|&i| b.values[i]).collect(),
+        geometry: idx.iter().map(|&i| b.geometry[i]).collect(),
+        values: rows(&b.values, 1.0),
         sqrt_weights: idx.iter().map(|&i| b.sqrt_weights[i] * w).collect(),
-        factors: idx.iter().map(|&i| b.factors[i].map(|k| k * w)).collect(),
+        factors: rows(&b.factors, w),
+        channels,
     }
 }
 
@@ -660,11 +695,8 @@ fn subsample(b: &Block, target: usize) -> Block {
 fn auto_floor(data: &[IncidenceData], channels: usize) -> f64 {
     let mut values: Vec<f64> = data
         .iter()
-        .flat_map(|d| {
-            d.samples
-                .iter()
-                .flat_map(move |s| s.value[..channels].to_vec())
-        })
+        .flat_map(|d| d.samples.iter())
+        .flat_map(|s| s.value.into_iter().take(channels))
         .filter(|v| *v > 0.0)
         .collect();
     if values.is_empty() {
