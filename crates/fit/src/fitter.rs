@@ -332,25 +332,27 @@ fn validate(data: &IncidenceData, config: &FitConfig) -> Result<(), FitError> {
         });
     }
     let channels = data.channels.clamp(1, 3);
+    // One pass: the first non-finite sample, any positive value, any
+    // back-hemisphere sample.
+    let (mut positive, mut back) = (false, false);
     for (index, s) in data.samples.iter().enumerate() {
-        if !s.weight.is_finite() || s.value[..channels].iter().any(|v| !v.is_finite()) {
+        let values = &s.value[..channels];
+        if !s.weight.is_finite() || values.iter().any(|v| !v.is_finite()) {
             return Err(FitError::NonFinite {
                 origin: data.source.clone(),
                 index,
             });
         }
+        positive |= values.iter().any(|&v| v > 0.0);
+        back |= s.view.z < 0.0;
     }
-    if data
-        .samples
-        .iter()
-        .all(|s| s.value[..channels].iter().all(|&v| v <= 0.0))
-    {
+    if !positive {
         return Err(FitError::AllZero {
             origin: data.source.clone(),
             count: data.samples.len(),
         });
     }
-    if config.kind.is_transmitting() && data.samples.iter().all(|s| s.view.z >= 0.0) {
+    if config.kind.is_transmitting() && !back {
         return Err(FitError::NoTransmission {
             origin: data.source.clone(),
             kind: config.kind,
@@ -395,15 +397,15 @@ fn fit_many(
     }
     let n_points: usize = blocks.iter().map(Block::len).sum();
     let mut evaluations = 0;
-    let solve = |blocks: &[Block], u0: DVector<f64>, patience: usize| -> Solved {
+    let solve = |blocks: &[Block], u0: DVector<f64>, stage: Stage| -> Solved {
         let problem = Problem::new(&map, config, orientation, blocks, channels, floor);
         let mut problem = problem;
         problem.u = u0.clone();
         let (problem, report) = LevenbergMarquardt::new()
-            .with_ftol(1e-10)
-            .with_xtol(1e-10)
+            .with_ftol(stage.tolerance)
+            .with_xtol(stage.tolerance)
             .with_gtol(1e-14)
-            .with_patience(patience)
+            .with_patience(stage.patience)
             .minimize(problem);
         // After User/Numerical stops the problem holds the rejected trial
         // point; fall back to the start then.
@@ -437,7 +439,7 @@ fn fit_many(
         // lowest cost (the first on ties), so the choice is deterministic.
         let ends: Vec<Solved> = starts
             .par_iter()
-            .map(|(_, u0)| solve(&sub, u0.clone(), 60))
+            .map(|(_, u0)| solve(&sub, u0.clone(), Stage::START))
             .collect();
         for ((rough, _), end) in starts.iter().zip(ends) {
             evaluations += end.evaluations;
@@ -451,7 +453,7 @@ fn fit_many(
         }
     }
     let u_start = best.map_or_else(|| starts[0].1.clone(), |(u, _)| u);
-    let mut solved = solve(&blocks, u_start, 200);
+    let mut solved = solve(&blocks, u_start, Stage::FINAL);
     evaluations += solved.evaluations;
     if !solved.cost.is_finite() {
         return Err(FitError::Failed {
@@ -490,7 +492,7 @@ fn fit_many(
                 b.set_factors(config.residual, floor);
             }
             let previous = solved.u.clone();
-            solved = solve(&blocks, previous.clone(), 200);
+            solved = solve(&blocks, previous.clone(), Stage::FINAL);
             evaluations += solved.evaluations;
             if (&solved.u - &previous).amax() < 1e-8 {
                 break;
@@ -599,6 +601,29 @@ fn fit_many(
     })
 }
 
+/// Tolerances of one Levenberg-Marquardt run.
+#[derive(Clone, Copy)]
+struct Stage {
+    /// ftol and xtol.
+    tolerance: f64,
+    /// Evaluation budget in units of (parameters + 1).
+    patience: usize,
+}
+
+impl Stage {
+    /// A start on the subsample only has to find its basin; the final fit
+    /// from the best start polishes.
+    const START: Stage = Stage {
+        tolerance: 1e-6,
+        patience: 60,
+    };
+    /// The fit on every sample.
+    const FINAL: Stage = Stage {
+        tolerance: 1e-10,
+        patience: 200,
+    };
+}
+
 /// Where one Levenberg-Marquardt run ended.
 struct Solved {
     u: DVector<f64>,
@@ -640,24 +665,20 @@ fn make_block(d: &IncidenceData, channels: usize, reference: &Bsdf) -> Block {
             .map(|s| reference.geometry(light, s.view))
             .collect()
     };
+    let mut values = Vec::with_capacity(d.samples.len() * channels);
+    let mut sqrt_weights = Vec::with_capacity(d.samples.len());
+    for s in &d.samples {
+        values.extend_from_slice(&s.value[..channels]);
+        sqrt_weights.push(if total > 0.0 {
+            (s.weight.max(0.0) / mean).sqrt()
+        } else {
+            1.0
+        });
+    }
     Block {
         geometry,
-        values: d
-            .samples
-            .iter()
-            .flat_map(|s| s.value.into_iter().take(channels))
-            .collect(),
-        sqrt_weights: d
-            .samples
-            .iter()
-            .map(|s| {
-                if total > 0.0 {
-                    (s.weight.max(0.0) / mean).sqrt()
-                } else {
-                    1.0
-                }
-            })
-            .collect(),
+        values,
+        sqrt_weights,
         factors: Vec::new(),
         channels,
     }
@@ -693,12 +714,12 @@ fn subsample(b: &Block, target: usize) -> Block {
 /// 10% of the 10th percentile of the positive values: below this, values
 /// count as noise for relative and log residuals.
 fn auto_floor(data: &[IncidenceData], channels: usize) -> f64 {
-    let mut values: Vec<f64> = data
-        .iter()
-        .flat_map(|d| d.samples.iter())
-        .flat_map(|s| s.value.into_iter().take(channels))
-        .filter(|v| *v > 0.0)
-        .collect();
+    let mut values = Vec::with_capacity(data.iter().map(|d| d.samples.len() * channels).sum());
+    for d in data {
+        for s in &d.samples {
+            values.extend(s.value[..channels].iter().filter(|&&v| v > 0.0));
+        }
+    }
     if values.is_empty() {
         return 1e-6;
     }

@@ -51,18 +51,14 @@ impl Block {
     /// Recomputes the residual factors for `kind` and `floor`.
     pub(crate) fn set_factors(&mut self, kind: ResidualKind, floor: f64) {
         let channels = self.channels;
-        self.factors = self
-            .values
-            .iter()
-            .enumerate()
-            .map(|(row, &y)| {
-                let sw = self.sqrt_weights[row / channels];
-                match kind {
-                    ResidualKind::Relative => sw / (y * y + floor * floor).sqrt(),
-                    ResidualKind::Absolute | ResidualKind::Log => sw,
-                }
-            })
-            .collect();
+        self.factors.clear();
+        self.factors.reserve(self.values.len());
+        for (y, &sw) in self.values.chunks_exact(channels).zip(&self.sqrt_weights) {
+            self.factors.extend(y.iter().map(|&y| match kind {
+                ResidualKind::Relative => sw / (y * y + floor * floor).sqrt(),
+                ResidualKind::Absolute | ResidualKind::Log => sw,
+            }));
+        }
     }
 }
 
@@ -163,18 +159,9 @@ impl<'a> Problem<'a> {
     /// depend on the thread count, so results are deterministic.
     fn pass<const COMPRESS: bool>(&self, u: &DVector<f64>) -> Option<Pass> {
         let (_, dp, material, scale) = self.physical(u)?;
-        let bsdf = Bsdf::new(&material, &self.options);
         let n = self.map.len();
         let width = n + 1;
         let m = self.n_residuals();
-        let channels = self.channels;
-        let columns: Vec<(Target, f64)> = self
-            .map
-            .slots
-            .iter()
-            .zip(&dp)
-            .map(|(s, &d)| (s.target, d))
-            .collect();
         let mut chunks: Vec<Chunk> = Vec::new();
         for (b, block) in self.blocks.iter().enumerate() {
             let mut start = 0;
@@ -184,60 +171,36 @@ impl<'a> Problem<'a> {
                 start = end;
             }
         }
-        let (floor, kind, blocks) = (self.floor, self.kind, self.blocks);
-        let floor2 = floor * floor;
-        let run_chunk = |&(b, start, end): &Chunk| -> ChunkResult {
-            let block = &blocks[b];
-            let rows = (end - start) * channels;
-            // Column-major [J | r] of this chunk, or just r.
-            let mut a = vec![0.0; if COMPRESS { rows * width } else { rows }];
-            let residual_column = if COMPRESS { n * rows } else { 0 };
-            let mut grad = Gradient::default();
-            let mut sum_rel = 0.0;
-            let mut finite = true;
-            let mut row = 0;
-            for i in start..end {
-                let g = &block.geometry[i];
-                let y = &block.values[i * channels..(i + 1) * channels];
-                let k = &block.factors[i * channels..(i + 1) * channels];
-                let f = if COMPRESS {
-                    bsdf.eval_geometry_with_gradient(g, &mut grad)
-                } else {
-                    bsdf.eval_geometry(g)
-                };
-                for ch in 0..channels {
-                    let model = scale * f[ch];
-                    let (res, dr_dm) = residual(kind, floor, model, y[ch], k[ch]);
-                    a[residual_column + row] = res;
-                    finite &= res.is_finite();
-                    let e = model - y[ch];
-                    sum_rel += e * e / (y[ch] * y[ch] + floor2);
-                    if COMPRESS {
-                        for (j, &(target, dp_du)) in columns.iter().enumerate() {
-                            let dm_dp = match target {
-                                Target::Arg(a) => scale * grad.d[a][ch],
-                                Target::Gray => {
-                                    scale * (grad.d[0][ch] + grad.d[1][ch] + grad.d[2][ch])
-                                }
-                                Target::Scale => f[ch],
-                            };
-                            let value = dr_dm * dm_dp * dp_du;
-                            finite &= value.is_finite();
-                            a[j * rows + row] = value;
-                        }
-                    }
-                    row += 1;
-                }
+        let kernel = Kernel {
+            bsdf: Bsdf::new(&material, &self.options),
+            columns: self
+                .map
+                .slots
+                .iter()
+                .zip(&dp)
+                .map(|(s, &d)| (s.target, d))
+                .collect(),
+            scale,
+            floor: self.floor,
+            kind: self.kind,
+            channels: self.channels,
+            blocks: self.blocks,
+        };
+        let run_chunk = |chunk: &Chunk| -> ChunkResult {
+            if !COMPRESS {
+                return kernel.residuals(*chunk);
             }
-            let data = if COMPRESS && finite {
-                householder_triangle(&mut a, rows, width)
-            } else {
-                a
-            };
-            ChunkResult {
-                data,
-                sum_rel,
-                finite,
+            match width {
+                2 => kernel.gram::<2>(*chunk),
+                3 => kernel.gram::<3>(*chunk),
+                4 => kernel.gram::<4>(*chunk),
+                5 => kernel.gram::<5>(*chunk),
+                6 => kernel.gram::<6>(*chunk),
+                7 => kernel.gram::<7>(*chunk),
+                8 => kernel.gram::<8>(*chunk),
+                9 => kernel.gram::<9>(*chunk),
+                10 => kernel.gram::<10>(*chunk),
+                _ => unreachable!("at most {} parameters", MAX_WIDTH - 1),
             }
         };
         let parts: Vec<ChunkResult> = if m >= PARALLEL_ROWS {
@@ -259,79 +222,166 @@ impl<'a> Problem<'a> {
                 residuals: DVector::from_vec(residuals),
             });
         }
-        // Stack the chunks' triangles (in chunk order) and reduce again.
-        let rows = parts.len() * width;
-        let mut stacked = vec![0.0; rows * width];
-        for (c, p) in parts.iter().enumerate() {
-            for j in 0..width {
-                let target = &mut stacked[j * rows + c * width..j * rows + (c + 1) * width];
-                target.copy_from_slice(&p.data[j * width..(j + 1) * width]);
+        // Sum the chunks' Gram matrices in chunk order, then factorise.
+        let mut gram = vec![0.0; width * width];
+        for p in &parts {
+            for (total, value) in gram.iter_mut().zip(&p.data) {
+                *total += value;
             }
         }
-        let triangle = householder_triangle(&mut stacked, rows, width);
+        let triangle = augmented_cholesky(&gram, width);
         Some(Pass::Compressed { triangle, rms_rel })
     }
 }
 
-/// Householder QR of the column-major `rows × cols` matrix `a` (which it
-/// overwrites); returns the `cols × cols` upper-triangular factor R,
-/// column-major, with zero rows where `rows < cols`.
-fn householder_triangle(a: &mut [f64], rows: usize, cols: usize) -> Vec<f64> {
-    let mut r = vec![0.0; cols * cols];
-    if rows == 0 {
-        return r;
-    }
-    let mut diagonal = vec![0.0; cols];
-    for k in 0..cols.min(rows) {
-        let (left, right) = a.split_at_mut((k + 1) * rows);
-        let v = &mut left[k * rows + k..];
-        let norm2 = dot(v, v);
-        if norm2 == 0.0 {
-            continue;
-        }
-        let norm = norm2.sqrt();
-        // Reflect x onto alpha·e₁ with the sign that avoids cancellation.
-        let alpha = if v[0] > 0.0 { -norm } else { norm };
-        v[0] -= alpha;
-        let v_norm2 = norm2 - 2.0 * alpha * (v[0] + alpha) + alpha * alpha;
-        for column in right.chunks_exact_mut(rows) {
-            let x = &mut column[k..];
-            let s = 2.0 * dot(v, x) / v_norm2;
-            for (xi, vi) in x.iter_mut().zip(v.iter()) {
-                *xi -= s * vi;
+/// Everything one pass needs per sample.
+struct Kernel<'a> {
+    bsdf: Bsdf,
+    /// What each free parameter drives, and dp/du.
+    columns: Vec<(Target, f64)>,
+    scale: f64,
+    floor: f64,
+    kind: ResidualKind,
+    channels: usize,
+    blocks: &'a [Block],
+}
+
+// Channel loops index values, factors and the gradient together.
+#[allow(clippy::needless_range_loop)]
+impl Kernel<'_> {
+    /// The residuals of one chunk.
+    fn residuals(&self, (b, start, end): Chunk) -> ChunkResult {
+        let block = &self.blocks[b];
+        let channels = self.channels;
+        let mut data = Vec::with_capacity((end - start) * channels);
+        let mut sum_rel = 0.0;
+        for i in start..end {
+            let f = self.bsdf.eval_geometry(&block.geometry[i]);
+            for ch in 0..channels {
+                let row = i * channels + ch;
+                let (res, _, rel2) = self.residual(f[ch], block.values[row], block.factors[row]);
+                data.push(res);
+                sum_rel += rel2;
             }
         }
-        diagonal[k] = alpha;
+        ChunkResult {
+            finite: data.iter().all(|r| r.is_finite()),
+            data,
+            sum_rel,
+        }
     }
-    for j in 0..cols {
-        for k in 0..=j.min(rows - 1) {
-            r[j * cols + k] = if k == j { diagonal[k] } else { a[j * rows + k] };
+
+    /// The upper triangle of `[J | r]ᵀ[J | r]` of one chunk (row-major,
+    /// `W × W`), for `W − 1` parameters; the fixed width lets the compiler
+    /// unroll the accumulation.
+    fn gram<const W: usize>(&self, (b, start, end): Chunk) -> ChunkResult {
+        let block = &self.blocks[b];
+        let channels = self.channels;
+        let columns: &[(Target, f64)] = &self.columns[..W - 1];
+        let mut gram = [[0.0; W]; W];
+        let mut x = [0.0; W];
+        let mut grad = Gradient::default();
+        let mut sum_rel = 0.0;
+        for i in start..end {
+            let g = &block.geometry[i];
+            let f = if channels == 1 {
+                self.bsdf
+                    .eval_geometry_channels_with_gradient::<1>(g, &mut grad)
+            } else {
+                self.bsdf.eval_geometry_with_gradient(g, &mut grad)
+            };
+            for ch in 0..channels {
+                let row = i * channels + ch;
+                let (res, dr_dm, rel2) =
+                    self.residual(f[ch], block.values[row], block.factors[row]);
+                sum_rel += rel2;
+                for (xj, &(target, dp_du)) in x.iter_mut().zip(columns) {
+                    let dm_dp = match target {
+                        Target::Arg(a) => self.scale * grad.d[a][ch],
+                        Target::Gray => {
+                            self.scale * (grad.d[0][ch] + grad.d[1][ch] + grad.d[2][ch])
+                        }
+                        Target::Scale => f[ch],
+                    };
+                    *xj = dr_dm * dm_dp * dp_du;
+                }
+                x[W - 1] = res;
+                for a in 0..W {
+                    for b in a..W {
+                        gram[a][b] += x[a] * x[b];
+                    }
+                }
+            }
+        }
+        let data: Vec<f64> = gram.iter().flatten().copied().collect();
+        ChunkResult {
+            finite: data.iter().all(|v| v.is_finite()),
+            data,
+            sum_rel,
+        }
+    }
+
+    /// The residual for BSDF value `f`, measured `y` and factor `k`, dr/dm,
+    /// and the squared relative error for `rms_rel`.
+    #[inline(always)]
+    fn residual(&self, f: f64, y: f64, k: f64) -> (f64, f64, f64) {
+        let model = self.scale * f;
+        let e = model - y;
+        let floor = self.floor;
+        let rel2 = e * e / (y * y + floor * floor);
+        let (res, dr_dm) = match self.kind {
+            ResidualKind::Absolute | ResidualKind::Relative => (k * e, k),
+            ResidualKind::Log => {
+                let a = model.max(0.0) + floor;
+                (k * (a.ln() - (y.max(0.0) + floor).ln()), k / a)
+            }
+        };
+        (res, dr_dm, rel2)
+    }
+}
+
+/// Widest `[J | r]`: every argument of a material, a free scale, the residual.
+const MAX_WIDTH: usize = brtf_model::MAX_ARGS + 2;
+
+/// The triangle `[[R, z], [0, ρ]]` (column-major, `width × width`) of the
+/// augmented Gram matrix `G = [J | r]ᵀ[J | r]` (upper triangle, row-major):
+/// `RᵀR = JᵀJ`, `Rᵀz = Jᵀr` and `ρ² = ‖r‖² − ‖z‖²`, so `‖(z, ρ)‖² = ‖r‖²`.
+///
+/// A column whose part independent of the columns before it falls below
+/// 1e-6 of its norm counts as dependent: its row of R is zero, as in a
+/// rank-revealing QR (LM copes with a zero diagonal). The test is relative
+/// to the column itself, so parameter scaling does not affect it. Forming
+/// JᵀJ squares the condition number; with at most nine well-scaled
+/// parameters LM's steps lose nothing that matters, and the cost ‖r‖²,
+/// which decides every step, is summed directly.
+fn augmented_cholesky(gram: &[f64], width: usize) -> Vec<f64> {
+    let n = width - 1;
+    let g = |a: usize, b: usize| gram[a.min(b) * width + a.max(b)];
+    // Column-major: entry (row i, column j) at j * width + i.
+    let mut r = vec![0.0; width * width];
+    for k in 0..width {
+        let mut pivot = g(k, k);
+        for i in 0..k {
+            pivot -= r[k * width + i] * r[k * width + i];
+        }
+        if k == n {
+            r[k * width + k] = pivot.max(0.0).sqrt();
+            break;
+        }
+        if pivot.is_nan() || pivot <= 1e-12 * g(k, k) {
+            continue;
+        }
+        let diagonal = pivot.sqrt();
+        r[k * width + k] = diagonal;
+        for j in k + 1..width {
+            let mut value = g(k, j);
+            for i in 0..k {
+                value -= r[k * width + i] * r[j * width + i];
+            }
+            r[j * width + k] = value / diagonal;
         }
     }
     r
-}
-
-/// `a · b` over the common length, with four running sums so the loop is
-/// not one long chain of dependent additions (the order is fixed, so the
-/// result is deterministic).
-#[inline]
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let n = a.len().min(b.len());
-    let (a, b) = (&a[..n], &b[..n]);
-    let mut sums = [0.0; 4];
-    let (a4, b4) = (a.chunks_exact(4), b.chunks_exact(4));
-    let tail: f64 = a4
-        .remainder()
-        .iter()
-        .zip(b4.remainder())
-        .map(|(x, y)| x * y)
-        .sum();
-    for (x, y) in a4.zip(b4) {
-        for k in 0..4 {
-            sums[k] += x[k] * y[k];
-        }
-    }
-    (sums[0] + sums[1]) + (sums[2] + sums[3]) + tail
 }
 
 /// A chunk of one block: (block, first sample, end sample).
@@ -339,7 +389,7 @@ type Chunk = (usize, usize, usize);
 
 /// What one chunk contributes to a pass.
 struct ChunkResult {
-    /// Its triangle of `[J | r]`, or its residuals.
+    /// Its Gram matrix of `[J | r]`, or its residuals.
     data: Vec<f64>,
     sum_rel: f64,
     finite: bool,
@@ -360,20 +410,10 @@ pub(crate) struct Compressed {
     pub rms_rel: f64,
 }
 
-/// Residual for model `m` and measured `y` with factor `k`, and dr/dm.
-#[inline(always)]
-fn residual(kind: ResidualKind, floor: f64, m: f64, y: f64, k: f64) -> (f64, f64) {
-    match kind {
-        ResidualKind::Absolute | ResidualKind::Relative => (k * (m - y), k),
-        ResidualKind::Log => {
-            let a = m.max(0.0) + floor;
-            (k * (a.ln() - (y.max(0.0) + floor).ln()), k / a)
-        }
-    }
-}
-
-/// Samples per chunk of a pass.
-const CHUNK: usize = 4096;
+/// Samples per chunk of a pass. A chunk's [J | r] (2048 × 4 doubles for
+/// three parameters) stays below the allocator's 128 KiB mmap threshold,
+/// which would otherwise cost fresh zeroed pages on every pass.
+const CHUNK: usize = 2048;
 /// Passes with at least this many residuals run their chunks in parallel.
 const PARALLEL_ROWS: usize = 16_384;
 

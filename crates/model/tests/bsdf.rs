@@ -102,6 +102,12 @@ proptest! {
         let b = bsdf.eval_with_gradient(l, v, &mut g2);
         prop_assert_eq!(a, b);
         prop_assert_eq!(g1, g2);
+        let mut g0 = Gradient::default();
+        let first = bsdf.eval_geometry_channels_with_gradient::<1>(&geometry, &mut g0);
+        prop_assert_eq!(first, [b[0], 0.0, 0.0]);
+        for (d0, d2) in g0.d.iter().zip(&g2.d) {
+            prop_assert_eq!(d0[0], d2[0]);
+        }
     }
 
     /// The reflection part of the radiance variant is reciprocal: f(l,v) = f(v,l).
