@@ -4,7 +4,8 @@
 //! and standard errors from s²(JᵀJ)⁻¹.
 
 use crate::data::{GateReport, IncidenceData};
-use crate::params::{MIN_ROUGHNESS, ParamMap, Target};
+use crate::params::{ParamMap, Target};
+use crate::prepare;
 use crate::problem::{Block, Compressed, Problem, ResidualKind};
 use brtf_model::{Bsdf, EvalOptions, MaterialKind};
 use glam::DVec3;
@@ -12,7 +13,6 @@ use levenberg_marquardt::{LevenbergMarquardt, TerminationReason};
 use nalgebra::DVector;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
-use std::f64::consts::PI;
 use std::time::Instant;
 
 /// Robust loss, applied by iteratively reweighting the residuals.
@@ -315,61 +315,12 @@ pub fn fit_global(data: &[IncidenceData], config: &FitConfig) -> Result<FitRepor
     fit_many(data, config, "all incidences")
 }
 
-fn validate(data: &IncidenceData, config: &FitConfig) -> Result<(), FitError> {
-    if data.samples.is_empty() {
-        let gates: Vec<String> = data
-            .gates
-            .iter()
-            .map(|g| format!("{} removed {}", g.gate, g.removed))
-            .collect();
-        return Err(FitError::EmptySelection {
-            origin: data.source.clone(),
-            gates: if gates.is_empty() {
-                "none".into()
-            } else {
-                gates.join(", ")
-            },
-        });
-    }
-    let channels = data.channels.clamp(1, 3);
-    // One pass: the first non-finite sample, any positive value, any
-    // back-hemisphere sample.
-    let (mut positive, mut back) = (false, false);
-    for (index, s) in data.samples.iter().enumerate() {
-        let values = &s.value[..channels];
-        if !s.weight.is_finite() || values.iter().any(|v| !v.is_finite()) {
-            return Err(FitError::NonFinite {
-                origin: data.source.clone(),
-                index,
-            });
-        }
-        positive |= values.iter().any(|&v| v > 0.0);
-        back |= s.view.z < 0.0;
-    }
-    if !positive {
-        return Err(FitError::AllZero {
-            origin: data.source.clone(),
-            count: data.samples.len(),
-        });
-    }
-    if config.kind.is_transmitting() && !back {
-        return Err(FitError::NoTransmission {
-            origin: data.source.clone(),
-            kind: config.kind,
-        });
-    }
-    Ok(())
-}
-
 fn fit_many(
     data: &[IncidenceData],
     config: &FitConfig,
     label: &str,
 ) -> Result<FitReport, FitError> {
     let started = Instant::now();
-    for d in data {
-        validate(d, config)?;
-    }
     let channels = data[0].channels.clamp(1, 3);
     if data.iter().any(|d| d.channels.clamp(1, 3) != channels) {
         return Err(FitError::MixedChannels);
@@ -377,21 +328,26 @@ fn fit_many(
     let gray = config.gray || channels == 1;
     let map = ParamMap::new(config.kind, gray, config.free_scale);
     let orientation = DVec3::from_array(config.orientation);
-    let floor = config.floor.unwrap_or_else(|| auto_floor(data, channels));
     // Light and views are fixed, so the argument-free part of the BSDF is
     // computed once per sample, by a Bsdf of the fitted type, orientation
     // and options (the arguments do not matter: the logistic mid-point).
-    let reference = Problem::new(&map, config, orientation, &[], channels, floor)
+    let reference = Problem::new(&map, config, orientation, &[], channels, 0.0)
         .physical(&DVector::zeros(map.len()))
         .map(|(_, _, material, _)| Bsdf::new(&material, &config.options))
         .ok_or_else(|| FitError::Failed {
             origin: label.into(),
             reason: "no valid material at the parameters' mid-points".into(),
         })?;
-    let mut blocks: Vec<Block> = data
-        .iter()
-        .map(|d| make_block(d, channels, &reference))
-        .collect();
+    let mut blocks = Vec::with_capacity(data.len());
+    let mut stats = Vec::with_capacity(data.len());
+    for d in data {
+        let scan = prepare::scan(d, channels, config, &reference)?;
+        blocks.push(scan.block);
+        stats.push(scan.stats);
+    }
+    let floor = config
+        .floor
+        .unwrap_or_else(|| prepare::auto_floor(&mut stats));
     for b in &mut blocks {
         b.set_factors(config.residual, floor);
     }
@@ -427,13 +383,13 @@ fn fit_many(
     };
 
     // Multi-start on a subsample, then the full fit from the best start.
-    let starts = starting_points(data, &map, config, channels);
+    let starts = prepare::starting_points(&mut stats, &map, config, channels);
     let mut records = Vec::new();
     let mut best: Option<(DVector<f64>, f64)> = None;
     if starts.len() > 1 {
         let sub: Vec<Block> = blocks
             .iter()
-            .map(|b| subsample(b, SUBSAMPLE / blocks.len().max(1)))
+            .map(|b| prepare::subsample(b, SUBSAMPLE / blocks.len().max(1)))
             .collect();
         // The starts are independent: run them in parallel, then pick the
         // lowest cost (the first on ties), so the choice is deterministic.
@@ -641,249 +597,4 @@ fn robust_sigma(r: &DVector<f64>) -> f64 {
     let mid = a.len() / 2;
     a.select_nth_unstable_by(mid, f64::total_cmp);
     (1.4826 * a[mid]).max(1e-300)
-}
-
-/// Normalised weights: each block's weights average 1, so the cost reads
-/// like an unweighted sum and (for the global fit) every incidence counts
-/// the same.
-fn make_block(d: &IncidenceData, channels: usize, reference: &Bsdf) -> Block {
-    let total: f64 = d.samples.iter().map(|s| s.weight.max(0.0)).sum();
-    let mean = if total > 0.0 {
-        total / d.samples.len() as f64
-    } else {
-        1.0
-    };
-    let light = d.light();
-    let geometry = if d.samples.len() >= PARALLEL_SAMPLES {
-        d.samples
-            .par_iter()
-            .map(|s| reference.geometry(light, s.view))
-            .collect()
-    } else {
-        d.samples
-            .iter()
-            .map(|s| reference.geometry(light, s.view))
-            .collect()
-    };
-    let mut values = Vec::with_capacity(d.samples.len() * channels);
-    let mut sqrt_weights = Vec::with_capacity(d.samples.len());
-    for s in &d.samples {
-        values.extend_from_slice(&s.value[..channels]);
-        sqrt_weights.push(if total > 0.0 {
-            (s.weight.max(0.0) / mean).sqrt()
-        } else {
-            1.0
-        });
-    }
-    Block {
-        geometry,
-        values,
-        sqrt_weights,
-        factors: Vec::new(),
-        channels,
-    }
-}
-
-/// Blocks with at least this many samples prepare their geometry in parallel.
-const PARALLEL_SAMPLES: usize = 16_384;
-
-/// Every k-th sample, keeping the block's weight total.
-fn subsample(b: &Block, target: usize) -> Block {
-    let step = (b.len() / target.max(1)).max(1);
-    let channels = b.channels;
-    let idx: Vec<usize> = (0..b.len()).step_by(step).collect();
-    let w = (step as f64).sqrt();
-    let rows = |v: &[f64], scale: f64| -> Vec<f64> {
-        idx.iter()
-            .flat_map(|&i| {
-                v[i * channels..(i + 1) * channels]
-                    .iter()
-                    .map(move |x| x * scale)
-            })
-            .collect()
-    };
-    Block {
-        geometry: idx.iter().map(|&i| b.geometry[i]).collect(),
-        values: rows(&b.values, 1.0),
-        sqrt_weights: idx.iter().map(|&i| b.sqrt_weights[i] * w).collect(),
-        factors: rows(&b.factors, w),
-        channels,
-    }
-}
-
-/// 10% of the 10th percentile of the positive values: below this, values
-/// count as noise for relative and log residuals.
-fn auto_floor(data: &[IncidenceData], channels: usize) -> f64 {
-    let mut values = Vec::with_capacity(data.iter().map(|d| d.samples.len() * channels).sum());
-    for d in data {
-        for s in &d.samples {
-            values.extend(s.value[..channels].iter().filter(|&&v| v > 0.0));
-        }
-    }
-    if values.is_empty() {
-        return 1e-6;
-    }
-    let k = values.len() / 10;
-    values.select_nth_unstable_by(k, f64::total_cmp);
-    (0.1 * values[k]).max(1e-12)
-}
-
-/// Lobe features read off the data of one incidence.
-struct DataFeatures {
-    /// Diffuse reflectance estimate (π × a low percentile).
-    diffuse: f64,
-    /// Peak height above the floor, in the data's unit.
-    peak: f64,
-    /// Angle (rad) from the mirror direction where the lobe falls to 1/e.
-    width: f64,
-    /// cos θ_in.
-    cos_in: f64,
-    /// Transmission estimate (back hemisphere).
-    transmission: f64,
-}
-
-fn features(d: &IncidenceData, channels: usize) -> DataFeatures {
-    let l = d.light();
-    let mirror = DVec3::new(-l.x, -l.y, l.z);
-    let mean =
-        |s: &crate::data::FitSample| s.value[..channels].iter().sum::<f64>() / channels as f64;
-    let mut front: Vec<f64> = d
-        .samples
-        .iter()
-        .filter(|s| s.view.z > 0.0)
-        .map(mean)
-        .collect();
-    let mut back: Vec<f64> = d
-        .samples
-        .iter()
-        .filter(|s| s.view.z < 0.0)
-        .map(mean)
-        .collect();
-    let percentile = |v: &mut Vec<f64>, q: f64| -> f64 {
-        if v.is_empty() {
-            return 0.0;
-        }
-        let k = ((v.len() - 1) as f64 * q) as usize;
-        *v.select_nth_unstable_by(k, f64::total_cmp).1
-    };
-    let floor = percentile(&mut front, 0.2).max(0.0);
-    // The peak: the largest value within 30° of the mirror direction
-    // (compared as cosines; the angle is taken once, for the width).
-    let near: Vec<(f64, f64)> = d
-        .samples
-        .iter()
-        .filter(|s| s.view.z > 0.0)
-        .map(|s| (s.view.dot(mirror), mean(s)))
-        .filter(|(cos_delta, _)| *cos_delta > 0.5f64.cos())
-        .collect();
-    let peak = near.iter().map(|(_, y)| *y).fold(0.0, f64::max) - floor;
-    let threshold = floor + peak / std::f64::consts::E;
-    let widest = near
-        .iter()
-        .filter(|(_, y)| *y >= threshold)
-        .map(|(cos_delta, _)| *cos_delta)
-        .fold(1.0, f64::min);
-    let width = widest.clamp(-1.0, 1.0).acos().max(0.005);
-    let back_median = percentile(&mut back, 0.5).max(0.0);
-    DataFeatures {
-        diffuse: (PI * floor).min(1.0),
-        peak: peak.max(0.0),
-        width,
-        cos_in: l.z.abs().max(0.05),
-        transmission: (PI * back_median).min(1.0),
-    }
-}
-
-/// Starting points: the data-driven roughness first, then a roughness
-/// grid. Each start derives the amplitudes from the data for its roughness.
-fn starting_points(
-    data: &[IncidenceData],
-    map: &ParamMap,
-    config: &FitConfig,
-    channels: usize,
-) -> Vec<([f64; 2], DVector<f64>)> {
-    // Features of the incidence closest to 30° stand for all of them.
-    let reference = data
-        .iter()
-        .min_by(|a, b| {
-            (a.theta_in - 30.0)
-                .abs()
-                .total_cmp(&(b.theta_in - 30.0).abs())
-        })
-        .expect("at least one incidence");
-    let f = features(reference, channels);
-    let alpha0 = (0.5 * f.width).clamp(MIN_ROUGHNESS * 2.0, 0.5);
-    let mut roughs: Vec<[f64; 2]> = vec![[alpha0, alpha0]];
-    if config.multistart {
-        let grid = [0.01, 0.03, 0.08, 0.2, 0.4];
-        if config.kind.is_anisotropic() {
-            for &a in &[0.02, 0.08, 0.25] {
-                for &b in &[0.02, 0.08, 0.25] {
-                    roughs.push([a, b]);
-                }
-            }
-        } else {
-            for &a in &grid {
-                if (a / alpha0).ln().abs() > 0.3 {
-                    roughs.push([a, a]);
-                }
-            }
-        }
-    }
-    let means: [f64; 3] = {
-        let mut m = [0.0; 3];
-        let front: Vec<_> = reference
-            .samples
-            .iter()
-            .filter(|s| s.view.z > 0.0)
-            .collect();
-        for s in &front {
-            for (acc, v) in m.iter_mut().zip(&s.value[..channels]) {
-                *acc += v;
-            }
-        }
-        let total: f64 = m[..channels].iter().sum::<f64>().max(1e-300);
-        let mut ratio = [1.0; 3];
-        if channels == 3 {
-            ratio = m.map(|mc| 3.0 * mc / total);
-        }
-        ratio
-    };
-    roughs
-        .into_iter()
-        .map(|rough| {
-            let alpha2 = rough[0] * rough[1];
-            // W-G-M-D peak height at the mirror direction: S/(4π α² cos²θ_in).
-            let spec_amp = (f.peak * 4.0 * PI * alpha2 * f.cos_in * f.cos_in).max(1e-4);
-            let total = (f.diffuse + spec_amp).max(1e-6);
-            let mut phys = Vec::new();
-            for slot in &map.slots {
-                let value = match slot.target {
-                    Target::Scale => total,
-                    Target::Gray => total.min(0.95),
-                    Target::Arg(a) if a < 3 => (total * means[a]).min(0.95),
-                    Target::Arg(3) => {
-                        let spec = if config.free_scale || config.kind.is_metal() {
-                            spec_amp / total
-                        } else {
-                            spec_amp
-                        };
-                        spec.clamp(0.01, 0.95)
-                    }
-                    Target::Arg(_) if slot.name == "rough" || slot.name == "rough_u" => rough[0],
-                    Target::Arg(_) if slot.name == "rough_v" => rough[1],
-                    Target::Arg(_) if slot.name == "trans" => f.transmission.clamp(0.05, 0.9),
-                    Target::Arg(_) => 0.5,
-                };
-                phys.push(value);
-            }
-            let u = DVector::from_iterator(
-                phys.len(),
-                phys.iter()
-                    .enumerate()
-                    .map(|(i, &p)| map.to_unconstrained(i, p)),
-            );
-            (rough, u)
-        })
-        .collect()
 }

@@ -19,6 +19,7 @@
 mod data;
 mod fitter;
 mod params;
+mod prepare;
 mod problem;
 mod result;
 mod table;

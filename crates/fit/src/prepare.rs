@@ -1,0 +1,382 @@
+//! From an incidence's samples to what the fitter needs, in one pass over
+//! the samples (they are large, so every extra pass costs memory
+//! bandwidth): the data checks, the fitter's [`Block`], and the statistics
+//! behind the automatic floor and the starting values.
+
+use crate::data::IncidenceData;
+use crate::fitter::{FitConfig, FitError};
+use crate::params::{MIN_ROUGHNESS, ParamMap, Target};
+use crate::problem::Block;
+use brtf_model::{Bsdf, Geometry};
+use glam::DVec3;
+use nalgebra::DVector;
+use rayon::prelude::*;
+use std::f64::consts::PI;
+
+/// Samples per piece of the pass; pieces run in parallel on large files.
+const PIECE: usize = 8192;
+/// Incidences with at least this many samples are scanned in parallel.
+const PARALLEL_SAMPLES: usize = 16_384;
+/// Half-angle around the mirror direction searched for the peak.
+const PEAK_CONE_RAD: f64 = 0.5;
+
+/// One incidence after the pass.
+pub(crate) struct Scan {
+    /// The fitter's samples (residual factors not yet set).
+    pub block: Block,
+    /// Statistics for the floor and the starting values.
+    pub stats: ScanStats,
+}
+
+/// What the starting values and the automatic floor are read from.
+pub(crate) struct ScanStats {
+    /// Every positive value, all channels.
+    pub positive: Vec<f64>,
+    /// Channel means of the front (v.z > 0) and back (v.z < 0) samples.
+    front: Vec<f64>,
+    back: Vec<f64>,
+    /// (cosine to the mirror direction, channel mean) of the front samples
+    /// within [`PEAK_CONE_RAD`] of it.
+    near: Vec<(f64, f64)>,
+    /// Per-channel sums over the front samples.
+    front_sums: [f64; 3],
+    /// The incidence's θ_in in degrees and cos θ_in.
+    theta_in: f64,
+    cos_in: f64,
+}
+
+/// A piece's index, its samples and its parts of the outputs (geometry;
+/// values and square-root weights).
+type PieceSlices<'a> = (
+    usize,
+    (
+        (&'a [crate::FitSample], &'a mut [Geometry]),
+        (&'a mut [f64], &'a mut [f64]),
+    ),
+);
+
+/// One piece's share of the pass.
+#[derive(Default)]
+struct Piece {
+    positive: Vec<f64>,
+    front: Vec<f64>,
+    back: Vec<f64>,
+    near: Vec<(f64, f64)>,
+    front_sums: [f64; 3],
+    weight_sum: f64,
+    /// Index of the first sample with a non-finite value or weight.
+    non_finite: Option<usize>,
+}
+
+/// Checks, prepares and summarises one incidence in one pass. `reference`
+/// is a Bsdf of the fitted type, orientation and options, which fixes
+/// the argument-free [`Geometry`] of every sample.
+///
+/// Weights are normalised to average 1, so the cost reads like an
+/// unweighted sum and, in the all-incidence fit, every incidence counts
+/// the same; without any positive weight every sample weighs 1.
+pub(crate) fn scan(
+    d: &IncidenceData,
+    channels: usize,
+    config: &FitConfig,
+    reference: &Bsdf,
+) -> Result<Scan, FitError> {
+    let n = d.samples.len();
+    if n == 0 {
+        let gates: Vec<String> = d
+            .gates
+            .iter()
+            .map(|g| format!("{} removed {}", g.gate, g.removed))
+            .collect();
+        return Err(FitError::EmptySelection {
+            origin: d.source.clone(),
+            gates: if gates.is_empty() {
+                "none".into()
+            } else {
+                gates.join(", ")
+            },
+        });
+    }
+    let light = d.light();
+    let mirror = DVec3::new(-light.x, -light.y, light.z);
+    let near_cosine = PEAK_CONE_RAD.cos();
+    let mut geometry = vec![Geometry::default(); n];
+    let mut values = vec![0.0; n * channels];
+    let mut sqrt_weights = vec![0.0; n];
+    let work = |(index, ((samples, geometry), (values, sqrt_weights))): PieceSlices| {
+        let mut piece = Piece::default();
+        for (i, s) in samples.iter().enumerate() {
+            let value = &s.value[..channels];
+            if piece.non_finite.is_none()
+                && (!s.weight.is_finite() || value.iter().any(|v| !v.is_finite()))
+            {
+                piece.non_finite = Some(index * PIECE + i);
+            }
+            geometry[i] = reference.geometry(light, s.view);
+            values[i * channels..(i + 1) * channels].copy_from_slice(value);
+            let weight = s.weight.max(0.0);
+            piece.weight_sum += weight;
+            sqrt_weights[i] = weight.sqrt();
+            piece.positive.extend(value.iter().filter(|&&v| v > 0.0));
+            let mean = value.iter().sum::<f64>() / channels as f64;
+            if s.view.z > 0.0 {
+                piece.front.push(mean);
+                for (sum, v) in piece.front_sums.iter_mut().zip(value) {
+                    *sum += v;
+                }
+                let cosine = s.view.dot(mirror);
+                if cosine > near_cosine {
+                    piece.near.push((cosine, mean));
+                }
+            } else if s.view.z < 0.0 {
+                piece.back.push(mean);
+            }
+        }
+        piece
+    };
+    let pieces: Vec<Piece> = if n >= PARALLEL_SAMPLES {
+        d.samples
+            .par_chunks(PIECE)
+            .zip(geometry.par_chunks_mut(PIECE))
+            .zip(
+                values
+                    .par_chunks_mut(PIECE * channels)
+                    .zip(sqrt_weights.par_chunks_mut(PIECE)),
+            )
+            .enumerate()
+            .map(work)
+            .collect()
+    } else {
+        d.samples
+            .chunks(PIECE)
+            .zip(geometry.chunks_mut(PIECE))
+            .zip(
+                values
+                    .chunks_mut(PIECE * channels)
+                    .zip(sqrt_weights.chunks_mut(PIECE)),
+            )
+            .enumerate()
+            .map(work)
+            .collect()
+    };
+    if let Some(index) = pieces.iter().find_map(|p| p.non_finite) {
+        return Err(FitError::NonFinite {
+            origin: d.source.clone(),
+            index,
+        });
+    }
+    let mut stats = ScanStats {
+        positive: Vec::new(),
+        front: Vec::new(),
+        back: Vec::new(),
+        near: Vec::new(),
+        front_sums: [0.0; 3],
+        theta_in: d.theta_in,
+        cos_in: light.z.abs().max(0.05),
+    };
+    let mut weight_sum = 0.0;
+    for p in pieces {
+        stats.positive.extend(p.positive);
+        stats.front.extend(p.front);
+        stats.back.extend(p.back);
+        stats.near.extend(p.near);
+        for (total, part) in stats.front_sums.iter_mut().zip(p.front_sums) {
+            *total += part;
+        }
+        weight_sum += p.weight_sum;
+    }
+    if stats.positive.is_empty() {
+        return Err(FitError::AllZero {
+            origin: d.source.clone(),
+            count: n,
+        });
+    }
+    if config.kind.is_transmitting() && stats.back.is_empty() {
+        return Err(FitError::NoTransmission {
+            origin: d.source.clone(),
+            kind: config.kind,
+        });
+    }
+    if weight_sum > 0.0 {
+        let norm = (n as f64 / weight_sum).sqrt();
+        for w in &mut sqrt_weights {
+            *w *= norm;
+        }
+    } else {
+        sqrt_weights.fill(1.0);
+    }
+    Ok(Scan {
+        block: Block {
+            geometry,
+            values,
+            sqrt_weights,
+            factors: Vec::new(),
+            channels,
+        },
+        stats,
+    })
+}
+
+/// 10% of the 10th percentile of the positive values of every incidence:
+/// below this, values count as noise for relative and log residuals.
+pub(crate) fn auto_floor(stats: &mut [ScanStats]) -> f64 {
+    let mut all = std::mem::take(&mut stats[0].positive);
+    for s in &stats[1..] {
+        all.extend_from_slice(&s.positive);
+    }
+    let k = all.len() / 10;
+    all.select_nth_unstable_by(k, f64::total_cmp);
+    (0.1 * all[k]).max(1e-12)
+}
+
+/// Every k-th sample, keeping the block's weight total.
+pub(crate) fn subsample(b: &Block, target: usize) -> Block {
+    let step = (b.len() / target.max(1)).max(1);
+    let channels = b.channels;
+    let idx: Vec<usize> = (0..b.len()).step_by(step).collect();
+    let w = (step as f64).sqrt();
+    let rows = |v: &[f64], scale: f64| -> Vec<f64> {
+        idx.iter()
+            .flat_map(|&i| {
+                v[i * channels..(i + 1) * channels]
+                    .iter()
+                    .map(move |x| x * scale)
+            })
+            .collect()
+    };
+    Block {
+        geometry: idx.iter().map(|&i| b.geometry[i]).collect(),
+        values: rows(&b.values, 1.0),
+        sqrt_weights: idx.iter().map(|&i| b.sqrt_weights[i] * w).collect(),
+        factors: rows(&b.factors, w),
+        channels,
+    }
+}
+
+/// Lobe features read off the data of one incidence.
+struct DataFeatures {
+    /// Diffuse reflectance estimate (π × a low percentile).
+    diffuse: f64,
+    /// Peak height above the floor, in the data's unit.
+    peak: f64,
+    /// Angle (rad) from the mirror direction where the lobe falls to 1/e.
+    width: f64,
+    /// cos θ_in.
+    cos_in: f64,
+    /// Transmission estimate (back hemisphere).
+    transmission: f64,
+}
+
+fn percentile(v: &mut [f64], q: f64) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    let k = ((v.len() - 1) as f64 * q) as usize;
+    *v.select_nth_unstable_by(k, f64::total_cmp).1
+}
+
+fn features(s: &mut ScanStats) -> DataFeatures {
+    let floor = percentile(&mut s.front, 0.2).max(0.0);
+    // The peak: the largest value near the mirror direction (compared as
+    // cosines; the angle is taken once, for the width).
+    let peak = s.near.iter().map(|(_, y)| *y).fold(0.0, f64::max) - floor;
+    let threshold = floor + peak / std::f64::consts::E;
+    let widest = s
+        .near
+        .iter()
+        .filter(|(_, y)| *y >= threshold)
+        .map(|(cos_delta, _)| *cos_delta)
+        .fold(1.0, f64::min);
+    let width = widest.clamp(-1.0, 1.0).acos().max(0.005);
+    let back_median = percentile(&mut s.back, 0.5).max(0.0);
+    DataFeatures {
+        diffuse: (PI * floor).min(1.0),
+        peak: peak.max(0.0),
+        width,
+        cos_in: s.cos_in,
+        transmission: (PI * back_median).min(1.0),
+    }
+}
+
+/// Starting points: the data-driven roughness first, then a roughness
+/// grid. Each start derives the amplitudes from the data for its roughness.
+pub(crate) fn starting_points(
+    stats: &mut [ScanStats],
+    map: &ParamMap,
+    config: &FitConfig,
+    channels: usize,
+) -> Vec<([f64; 2], DVector<f64>)> {
+    // Features of the incidence closest to 30° stand for all of them.
+    let reference = stats
+        .iter_mut()
+        .min_by(|a, b| {
+            (a.theta_in - 30.0)
+                .abs()
+                .total_cmp(&(b.theta_in - 30.0).abs())
+        })
+        .expect("at least one incidence");
+    let f = features(reference);
+    let alpha0 = (0.5 * f.width).clamp(MIN_ROUGHNESS * 2.0, 0.5);
+    let mut roughs: Vec<[f64; 2]> = vec![[alpha0, alpha0]];
+    if config.multistart {
+        let grid = [0.01, 0.03, 0.08, 0.2, 0.4];
+        if config.kind.is_anisotropic() {
+            for &a in &[0.02, 0.08, 0.25] {
+                for &b in &[0.02, 0.08, 0.25] {
+                    roughs.push([a, b]);
+                }
+            }
+        } else {
+            for &a in &grid {
+                if (a / alpha0).ln().abs() > 0.3 {
+                    roughs.push([a, a]);
+                }
+            }
+        }
+    }
+    // Colour ratios of the front data.
+    let sums = reference.front_sums;
+    let total: f64 = sums[..channels].iter().sum::<f64>().max(1e-300);
+    let means = if channels == 3 {
+        sums.map(|mc| 3.0 * mc / total)
+    } else {
+        [1.0; 3]
+    };
+    roughs
+        .into_iter()
+        .map(|rough| {
+            let alpha2 = rough[0] * rough[1];
+            // W-G-M-D peak height at the mirror direction: S/(4π α² cos²θ_in).
+            let spec_amp = (f.peak * 4.0 * PI * alpha2 * f.cos_in * f.cos_in).max(1e-4);
+            let total = (f.diffuse + spec_amp).max(1e-6);
+            let mut phys = Vec::new();
+            for slot in &map.slots {
+                let value = match slot.target {
+                    Target::Scale => total,
+                    Target::Gray => total.min(0.95),
+                    Target::Arg(a) if a < 3 => (total * means[a]).min(0.95),
+                    Target::Arg(3) => {
+                        let spec = if config.free_scale || config.kind.is_metal() {
+                            spec_amp / total
+                        } else {
+                            spec_amp
+                        };
+                        spec.clamp(0.01, 0.95)
+                    }
+                    Target::Arg(_) if slot.name == "rough" || slot.name == "rough_u" => rough[0],
+                    Target::Arg(_) if slot.name == "rough_v" => rough[1],
+                    Target::Arg(_) if slot.name == "trans" => f.transmission.clamp(0.05, 0.9),
+                    Target::Arg(_) => 0.5,
+                };
+                phys.push(value);
+            }
+            let u = DVector::from_iterator(
+                phys.len(),
+                phys.iter()
+                    .enumerate()
+                    .map(|(i, &p)| map.to_unconstrained(i, p)),
+            );
+            (rough, u)
+        })
+        .collect()
+}
