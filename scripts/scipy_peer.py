@@ -4,9 +4,10 @@ would write with scipy.optimize.least_squares (bounded trust-region, vectorised
 numpy model and analytic Jacobian), on the same 120 000-point data and with the
 same residuals as brtf's default (relative with a floor, solid-angle weights).
 
-Reads target/fit-bench-metal.csv (written by `cargo bench -p brtf-fit`),
-prints the median time of several runs and the cost 1/2 sum r^2.
-Run through scripts/bench-fit.sh, which measures brtf in the same run.
+Reads target/fit-bench-metal.csv (written by `cargo bench -p brtf-fit`).
+Alone it prints the median time of several runs and the cost 1/2 sum r^2;
+with `--serve FILE` it fits on request, for the brtf bench (`vs_scipy`,
+run by scripts/bench-fit.sh), which alternates its own fits with these.
 """
 import sys
 import time
@@ -45,9 +46,13 @@ def model(p, tan2, norm):
     return c * (1 - rs) / np.pi + c * rs * d, d
 
 
-def main():
-    path = sys.argv[1] if len(sys.argv) > 1 else "target/fit-bench-metal.csv"
-    runs = int(sys.argv[2]) if len(sys.argv) > 2 else 5
+def fit(residuals, jacobian):
+    return least_squares(residuals, [0.5, 0.5, 0.1], jac=jacobian,
+                         bounds=([0, 0, 0.002], [1, 1, 1]), method="trf",
+                         ftol=1e-12, xtol=1e-12, gtol=1e-14)
+
+
+def problem(path):
     light, views, y, w = load(path)
     k, tan2, norm = setup(light, views, y, w)
 
@@ -64,20 +69,45 @@ def main():
             k * c * rs * dd_da,
         ])
 
+    return residuals, jacobian
+
+
+def serve(path):
+    """One fit per `fit` line on stdin, answering `<milliseconds> <cost> <c> <rs> <a>`:
+    the brtf bench alternates these with its own fits, so both run under the
+    same machine conditions. `cost c rs a` answers this script's cost at
+    those parameters, so both solutions are judged by one cost function."""
+    residuals, jacobian = problem(path)
+    print("ready", flush=True)
+    for line in sys.stdin:
+        words = line.split()
+        if words[:1] == ["cost"]:
+            # The peer's own cost function at someone else's parameters.
+            r = residuals(np.array([float(x) for x in words[1:4]]))
+            print(f"{0.5 * np.dot(r, r):.17g}", flush=True)
+            continue
+        if words != ["fit"]:
+            break
+        t0 = time.perf_counter()
+        result = fit(residuals, jacobian)
+        ms = 1e3 * (time.perf_counter() - t0)
+        c, rs, a = result.x
+        print(f"{ms:.3f} {result.cost:.17g} {c:.17g} {rs:.17g} {a:.17g}", flush=True)
+
+
+def main():
+    if len(sys.argv) > 2 and sys.argv[1] == "--serve":
+        serve(sys.argv[2])
+        return
+    path = sys.argv[1] if len(sys.argv) > 1 else "target/fit-bench-metal.csv"
+    runs = int(sys.argv[2]) if len(sys.argv) > 2 else 5
+    residuals, jacobian = problem(path)
     times, result = [], None
     for _ in range(runs):
         t0 = time.perf_counter()
-        result = least_squares(residuals, [0.5, 0.5, 0.1], jac=jacobian,
-                               bounds=([0, 0, 0.002], [1, 1, 1]), method="trf",
-                               ftol=1e-12, xtol=1e-12, gtol=1e-14)
+        result = fit(residuals, jacobian)
         times.append(time.perf_counter() - t0)
     c, rs, a = result.x
-    if len(sys.argv) > 3:
-        import json
-        with open(sys.argv[3]) as f:
-            brtf_ms = json.load(f)["median"]["point_estimate"] / 1e6
-        print(f"brtf (criterion median): {brtf_ms:.1f} ms; scipy median {1e3 * np.median(times):.1f} ms; "
-              f"ratio {1e3 * np.median(times) / brtf_ms:.1f}x")
     print(f"scipy least_squares (trf, analytic jacobian): median {1e3 * np.median(times):.1f} ms "
           f"over {runs} runs; colour {c:.5f} spec {rs:.5f} rough {a:.5f} cost {result.cost:.6e} "
           f"nfev {result.nfev}")

@@ -7,7 +7,7 @@ use crate::data::{GateReport, IncidenceData};
 use crate::params::{ParamMap, Target};
 use crate::prepare;
 use crate::problem::{Block, Compressed, Problem, ResidualKind};
-use brtf_model::{Bsdf, EvalOptions, MaterialKind};
+use brtf_model::{EvalOptions, MaterialKind};
 use glam::DVec3;
 use levenberg_marquardt::{LevenbergMarquardt, TerminationReason};
 use nalgebra::DVector;
@@ -328,26 +328,14 @@ fn fit_many(
     let gray = config.gray || channels == 1;
     let map = ParamMap::new(config.kind, gray, config.free_scale);
     let orientation = DVec3::from_array(config.orientation);
-    // Light and views are fixed, so the argument-free part of the BSDF is
-    // computed once per sample, by a Bsdf of the fitted type, orientation
-    // and options (the arguments do not matter: the logistic mid-point).
-    let reference = Problem::new(&map, config, orientation, &[], channels, 0.0)
-        .physical(&DVector::zeros(map.len()))
-        .map(|(_, _, material, _)| Bsdf::new(&material, &config.options))
-        .ok_or_else(|| FitError::Failed {
-            origin: label.into(),
-            reason: "no valid material at the parameters' mid-points".into(),
-        })?;
     let mut blocks = Vec::with_capacity(data.len());
     let mut stats = Vec::with_capacity(data.len());
     for d in data {
-        let scan = prepare::scan(d, channels, config, &reference)?;
+        let scan = prepare::scan(d, channels, config)?;
         blocks.push(scan.block);
         stats.push(scan.stats);
     }
-    let floor = config
-        .floor
-        .unwrap_or_else(|| prepare::auto_floor(&mut stats));
+    let floor = config.floor.unwrap_or_else(|| prepare::auto_floor(&stats));
     for b in &mut blocks {
         b.set_factors(config.residual, floor);
     }
@@ -383,7 +371,7 @@ fn fit_many(
     };
 
     // Multi-start on a subsample, then the full fit from the best start.
-    let starts = prepare::starting_points(&mut stats, &map, config, channels);
+    let starts = prepare::starting_points(&stats, &map, config, channels);
     let mut records = Vec::new();
     let mut best: Option<(DVector<f64>, f64)> = None;
     if starts.len() > 1 {
@@ -428,8 +416,9 @@ fn fit_many(
             };
             let sigma = robust_sigma(&r);
             let mut row = 0;
-            for (b, orig) in blocks.iter_mut().zip(&base) {
-                for i in 0..b.len() {
+            for b in blocks.iter_mut() {
+                let mut multipliers = Vec::with_capacity(b.len());
+                for _ in 0..b.len() {
                     let z = (0..channels).map(|c| r[row + c].abs()).fold(0.0, f64::max) / sigma;
                     row += channels;
                     let w = match config.loss {
@@ -443,8 +432,9 @@ fn fit_many(
                         RobustLoss::Cauchy(c) => 1.0 / (1.0 + (z / c) * (z / c)),
                         RobustLoss::None => 1.0,
                     };
-                    b.sqrt_weights[i] = orig.sqrt_weights[i] * w.sqrt();
+                    multipliers.push(w.sqrt());
                 }
+                b.robust = Some(multipliers);
                 b.set_factors(config.residual, floor);
             }
             let previous = solved.u.clone();
@@ -575,7 +565,7 @@ impl Stage {
     };
     /// The fit on every sample.
     const FINAL: Stage = Stage {
-        tolerance: 1e-10,
+        tolerance: 1e-12,
         patience: 200,
     };
 }

@@ -3,14 +3,15 @@
 //! bandwidth): the data checks, the fitter's [`Block`], and the statistics
 //! behind the automatic floor and the starting values.
 
-use crate::data::IncidenceData;
+use crate::data::{FitSample, IncidenceData};
 use crate::fitter::{FitConfig, FitError};
 use crate::params::{MIN_ROUGHNESS, ParamMap, Target};
 use crate::problem::Block;
-use brtf_model::{Bsdf, Geometry};
 use glam::DVec3;
 use nalgebra::DVector;
 use rayon::prelude::*;
+use std::borrow::Cow;
+use std::cell::RefCell;
 use std::f64::consts::PI;
 
 /// Samples per piece of the pass; pieces run in parallel on large files.
@@ -21,66 +22,76 @@ const PARALLEL_SAMPLES: usize = 16_384;
 const PEAK_CONE_RAD: f64 = 0.5;
 
 /// One incidence after the pass.
-pub(crate) struct Scan {
+pub(crate) struct Scan<'a> {
     /// The fitter's samples (residual factors not yet set).
-    pub block: Block,
+    pub block: Block<'a>,
     /// Statistics for the floor and the starting values.
     pub stats: ScanStats,
 }
 
-/// What the starting values and the automatic floor are read from.
+/// What the starting values and the automatic floor are read from, kept
+/// in the pass's pieces: joining them would cost fresh memory, and fresh
+/// pages are dear.
 pub(crate) struct ScanStats {
-    /// Every positive value, all channels.
-    pub positive: Vec<f64>,
-    /// Channel means of the front (v.z > 0) and back (v.z < 0) samples.
-    front: Vec<f64>,
-    back: Vec<f64>,
-    /// (cosine to the mirror direction, channel mean) of the front samples
-    /// within [`PEAK_CONE_RAD`] of it.
-    near: Vec<(f64, f64)>,
-    /// Per-channel sums over the front samples.
-    front_sums: [f64; 3],
+    pieces: Vec<Piece>,
     /// The incidence's θ_in in degrees and cos θ_in.
     theta_in: f64,
     cos_in: f64,
 }
 
-/// A piece's index, its samples and its parts of the outputs (geometry;
-/// values and square-root weights).
-type PieceSlices<'a> = (
-    usize,
-    (
-        (&'a [crate::FitSample], &'a mut [Geometry]),
-        (&'a mut [f64], &'a mut [f64]),
-    ),
-);
-
 /// One piece's share of the pass.
 #[derive(Default)]
 struct Piece {
+    /// Every positive value, all channels.
     positive: Vec<f64>,
+    /// Channel means of the front (v.z > 0) and back (v.z < 0) samples.
     front: Vec<f64>,
     back: Vec<f64>,
+    /// (cosine to the mirror direction, channel mean) of the front
+    /// samples within [`PEAK_CONE_RAD`] of it.
     near: Vec<(f64, f64)>,
+    /// Per-channel sums over the front samples.
     front_sums: [f64; 3],
     weight_sum: f64,
     /// Index of the first sample with a non-finite value or weight.
     non_finite: Option<usize>,
 }
 
-/// Checks, prepares and summarises one incidence in one pass. `reference`
-/// is a Bsdf of the fitted type, orientation and options, which fixes
-/// the argument-free [`Geometry`] of every sample.
+thread_local! {
+    /// Scratch for the order statistics, kept between fits so that each
+    /// fit does not fault in fresh pages for a throw-away copy.
+    static SCRATCH: RefCell<Vec<f64>> = const { RefCell::new(Vec::new()) };
+}
+
+/// The value at rank `rank(len)` of the concatenated `parts` (or `None`
+/// when they are empty), by selection in the thread's scratch buffer.
+fn order_statistic<'p>(
+    parts: impl Iterator<Item = &'p [f64]>,
+    rank: impl Fn(usize) -> usize,
+) -> Option<f64> {
+    SCRATCH.with_borrow_mut(|all| {
+        all.clear();
+        for part in parts {
+            all.extend_from_slice(part);
+        }
+        if all.is_empty() {
+            return None;
+        }
+        let k = rank(all.len());
+        Some(*all.select_nth_unstable_by(k, f64::total_cmp).1)
+    })
+}
+
+/// Checks, prepares and summarises one incidence in one pass.
 ///
 /// Weights are normalised to average 1, so the cost reads like an
 /// unweighted sum and, in the all-incidence fit, every incidence counts
 /// the same; without any positive weight every sample weighs 1.
-pub(crate) fn scan(
-    d: &IncidenceData,
+pub(crate) fn scan<'a>(
+    d: &'a IncidenceData,
     channels: usize,
     config: &FitConfig,
-    reference: &Bsdf,
-) -> Result<Scan, FitError> {
+) -> Result<Scan<'a>, FitError> {
     let n = d.samples.len();
     if n == 0 {
         let gates: Vec<String> = d
@@ -100,11 +111,12 @@ pub(crate) fn scan(
     let light = d.light();
     let mirror = DVec3::new(-light.x, -light.y, light.z);
     let near_cosine = PEAK_CONE_RAD.cos();
-    let mut geometry = vec![Geometry::default(); n];
-    let mut values = vec![0.0; n * channels];
-    let mut sqrt_weights = vec![0.0; n];
-    let work = |(index, ((samples, geometry), (values, sqrt_weights))): PieceSlices| {
-        let mut piece = Piece::default();
+    let work = |(index, samples): (usize, &[FitSample])| {
+        let mut piece = Piece {
+            positive: Vec::with_capacity(samples.len() * channels),
+            front: Vec::with_capacity(samples.len()),
+            ..Piece::default()
+        };
         for (i, s) in samples.iter().enumerate() {
             let value = &s.value[..channels];
             if piece.non_finite.is_none()
@@ -112,12 +124,12 @@ pub(crate) fn scan(
             {
                 piece.non_finite = Some(index * PIECE + i);
             }
-            geometry[i] = reference.geometry(light, s.view);
-            values[i * channels..(i + 1) * channels].copy_from_slice(value);
-            let weight = s.weight.max(0.0);
-            piece.weight_sum += weight;
-            sqrt_weights[i] = weight.sqrt();
-            piece.positive.extend(value.iter().filter(|&&v| v > 0.0));
+            piece.weight_sum += s.weight.max(0.0);
+            for &v in value {
+                if v > 0.0 {
+                    piece.positive.push(v);
+                }
+            }
             let mean = value.iter().sum::<f64>() / channels as f64;
             if s.view.z > 0.0 {
                 piece.front.push(mean);
@@ -135,29 +147,9 @@ pub(crate) fn scan(
         piece
     };
     let pieces: Vec<Piece> = if n >= PARALLEL_SAMPLES {
-        d.samples
-            .par_chunks(PIECE)
-            .zip(geometry.par_chunks_mut(PIECE))
-            .zip(
-                values
-                    .par_chunks_mut(PIECE * channels)
-                    .zip(sqrt_weights.par_chunks_mut(PIECE)),
-            )
-            .enumerate()
-            .map(work)
-            .collect()
+        d.samples.par_chunks(PIECE).enumerate().map(work).collect()
     } else {
-        d.samples
-            .chunks(PIECE)
-            .zip(geometry.chunks_mut(PIECE))
-            .zip(
-                values
-                    .chunks_mut(PIECE * channels)
-                    .zip(sqrt_weights.chunks_mut(PIECE)),
-            )
-            .enumerate()
-            .map(work)
-            .collect()
+        d.samples.chunks(PIECE).enumerate().map(work).collect()
     };
     if let Some(index) = pieces.iter().find_map(|p| p.non_finite) {
         return Err(FitError::NonFinite {
@@ -165,90 +157,74 @@ pub(crate) fn scan(
             index,
         });
     }
-    let mut stats = ScanStats {
-        positive: Vec::new(),
-        front: Vec::new(),
-        back: Vec::new(),
-        near: Vec::new(),
-        front_sums: [0.0; 3],
-        theta_in: d.theta_in,
-        cos_in: light.z.abs().max(0.05),
-    };
-    let mut weight_sum = 0.0;
-    for p in pieces {
-        stats.positive.extend(p.positive);
-        stats.front.extend(p.front);
-        stats.back.extend(p.back);
-        stats.near.extend(p.near);
-        for (total, part) in stats.front_sums.iter_mut().zip(p.front_sums) {
-            *total += part;
-        }
-        weight_sum += p.weight_sum;
-    }
-    if stats.positive.is_empty() {
+    if pieces.iter().all(|p| p.positive.is_empty()) {
         return Err(FitError::AllZero {
             origin: d.source.clone(),
             count: n,
         });
     }
-    if config.kind.is_transmitting() && stats.back.is_empty() {
+    if config.kind.is_transmitting() && pieces.iter().all(|p| p.back.is_empty()) {
         return Err(FitError::NoTransmission {
             origin: d.source.clone(),
             kind: config.kind,
         });
     }
-    if weight_sum > 0.0 {
-        let norm = (n as f64 / weight_sum).sqrt();
-        for w in &mut sqrt_weights {
-            *w *= norm;
-        }
-    } else {
-        sqrt_weights.fill(1.0);
-    }
+    let weight_sum: f64 = pieces.iter().map(|p| p.weight_sum).sum();
+    let unit_weights = weight_sum <= 0.0;
     Ok(Scan {
         block: Block {
-            geometry,
-            values,
-            sqrt_weights,
+            light,
+            samples: Cow::Borrowed(&d.samples),
+            weight_scale: if unit_weights {
+                1.0
+            } else {
+                (n as f64 / weight_sum).sqrt()
+            },
+            unit_weights,
+            robust: None,
             factors: Vec::new(),
             channels,
         },
-        stats,
+        stats: ScanStats {
+            pieces,
+            theta_in: d.theta_in,
+            cos_in: light.z.abs().max(0.05),
+        },
     })
 }
 
 /// 10% of the 10th percentile of the positive values of every incidence:
 /// below this, values count as noise for relative and log residuals.
-pub(crate) fn auto_floor(stats: &mut [ScanStats]) -> f64 {
-    let mut all = std::mem::take(&mut stats[0].positive);
-    for s in &stats[1..] {
-        all.extend_from_slice(&s.positive);
-    }
-    let k = all.len() / 10;
-    all.select_nth_unstable_by(k, f64::total_cmp);
-    (0.1 * all[k]).max(1e-12)
+pub(crate) fn auto_floor(stats: &[ScanStats]) -> f64 {
+    let parts = stats
+        .iter()
+        .flat_map(|s| s.pieces.iter().map(|p| p.positive.as_slice()));
+    let tenth = order_statistic(parts, |len| len / 10).unwrap_or(1e-5);
+    (0.1 * tenth).max(1e-12)
 }
 
 /// Every k-th sample, keeping the block's weight total.
-pub(crate) fn subsample(b: &Block, target: usize) -> Block {
+pub(crate) fn subsample<'a>(b: &Block<'_>, target: usize) -> Block<'a> {
     let step = (b.len() / target.max(1)).max(1);
     let channels = b.channels;
-    let idx: Vec<usize> = (0..b.len()).step_by(step).collect();
+    let picked = (0..b.len()).step_by(step);
     let w = (step as f64).sqrt();
-    let rows = |v: &[f64], scale: f64| -> Vec<f64> {
-        idx.iter()
-            .flat_map(|&i| {
-                v[i * channels..(i + 1) * channels]
-                    .iter()
-                    .map(move |x| x * scale)
-            })
-            .collect()
-    };
     Block {
-        geometry: idx.iter().map(|&i| b.geometry[i]).collect(),
-        values: rows(&b.values, 1.0),
-        sqrt_weights: idx.iter().map(|&i| b.sqrt_weights[i] * w).collect(),
-        factors: rows(&b.factors, w),
+        light: b.light,
+        samples: Cow::Owned(picked.clone().map(|i| b.samples[i]).collect()),
+        weight_scale: b.weight_scale * w,
+        unit_weights: b.unit_weights,
+        robust: b
+            .robust
+            .as_ref()
+            .map(|r| picked.clone().map(|i| r[i]).collect()),
+        factors: picked
+            .flat_map(|i| {
+                b.factors[i * channels..(i + 1) * channels]
+                    .iter()
+                    .map(move |k| k * w)
+            })
+            .collect(),
         channels,
     }
 }
@@ -267,28 +243,24 @@ struct DataFeatures {
     transmission: f64,
 }
 
-fn percentile(v: &mut [f64], q: f64) -> f64 {
-    if v.is_empty() {
-        return 0.0;
-    }
-    let k = ((v.len() - 1) as f64 * q) as usize;
-    *v.select_nth_unstable_by(k, f64::total_cmp).1
+/// The `q` quantile (by rank `⌊(len − 1) q⌋`) of the concatenated parts.
+fn quantile<'p>(parts: impl Iterator<Item = &'p [f64]>, q: f64) -> f64 {
+    order_statistic(parts, |len| ((len - 1) as f64 * q) as usize).unwrap_or(0.0)
 }
 
-fn features(s: &mut ScanStats) -> DataFeatures {
-    let floor = percentile(&mut s.front, 0.2).max(0.0);
+fn features(s: &ScanStats) -> DataFeatures {
+    let floor = quantile(s.pieces.iter().map(|p| p.front.as_slice()), 0.2).max(0.0);
     // The peak: the largest value near the mirror direction (compared as
     // cosines; the angle is taken once, for the width).
-    let peak = s.near.iter().map(|(_, y)| *y).fold(0.0, f64::max) - floor;
+    let near = || s.pieces.iter().flat_map(|p| p.near.iter());
+    let peak = near().map(|(_, y)| *y).fold(0.0, f64::max) - floor;
     let threshold = floor + peak / std::f64::consts::E;
-    let widest = s
-        .near
-        .iter()
+    let widest = near()
         .filter(|(_, y)| *y >= threshold)
         .map(|(cos_delta, _)| *cos_delta)
         .fold(1.0, f64::min);
     let width = widest.clamp(-1.0, 1.0).acos().max(0.005);
-    let back_median = percentile(&mut s.back, 0.5).max(0.0);
+    let back_median = quantile(s.pieces.iter().map(|p| p.back.as_slice()), 0.5).max(0.0);
     DataFeatures {
         diffuse: (PI * floor).min(1.0),
         peak: peak.max(0.0),
@@ -301,14 +273,14 @@ fn features(s: &mut ScanStats) -> DataFeatures {
 /// Starting points: the data-driven roughness first, then a roughness
 /// grid. Each start derives the amplitudes from the data for its roughness.
 pub(crate) fn starting_points(
-    stats: &mut [ScanStats],
+    stats: &[ScanStats],
     map: &ParamMap,
     config: &FitConfig,
     channels: usize,
 ) -> Vec<([f64; 2], DVector<f64>)> {
     // Features of the incidence closest to 30° stand for all of them.
     let reference = stats
-        .iter_mut()
+        .iter()
         .min_by(|a, b| {
             (a.theta_in - 30.0)
                 .abs()
@@ -335,7 +307,12 @@ pub(crate) fn starting_points(
         }
     }
     // Colour ratios of the front data.
-    let sums = reference.front_sums;
+    let mut sums = [0.0; 3];
+    for p in &reference.pieces {
+        for (total, part) in sums.iter_mut().zip(p.front_sums) {
+            *total += part;
+        }
+    }
     let total: f64 = sums[..channels].iter().sum::<f64>().max(1e-300);
     let means = if channels == 3 {
         sums.map(|mc| 3.0 * mc / total)

@@ -2,13 +2,15 @@
 //! residuals and the exact Jacobian from brtf-model's analytic gradients,
 //! in the unconstrained coordinates of [`ParamMap`].
 
+use crate::data::FitSample;
 use crate::params::{ParamMap, Target};
-use brtf_model::{Bsdf, EvalOptions, Geometry, Gradient, Material};
+use brtf_model::{Bsdf, EvalOptions, Gradient, Material};
 use glam::DVec3;
 use levenberg_marquardt::LeastSquaresProblem;
 use nalgebra::{DMatrix, DVector, Dyn, Owned};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+use std::borrow::Cow;
 use std::cell::{Cell, RefCell};
 
 /// How a model value m is compared with a measured value y.
@@ -30,43 +32,90 @@ pub enum ResidualKind {
 
 /// The samples of one incidence, ready for the inner loop.
 #[derive(Debug, Clone)]
-pub(crate) struct Block {
-    /// The argument-free part of the BSDF per sample (brtf-model's
-    /// [`Geometry`]), computed once per fit since light and views are fixed.
-    pub geometry: Vec<Geometry>,
-    /// Measured values, `channels` per sample.
-    pub values: Vec<f64>,
-    /// √(weight) per sample, including any robust-loss reweighting.
-    pub sqrt_weights: Vec<f64>,
-    /// Per value, the factor turning `m − y` into a residual.
+pub(crate) struct Block<'a> {
+    /// Unit vector towards the light.
+    pub light: DVec3,
+    /// The samples, borrowed from the caller (owned for a subsample). The
+    /// argument-free part of the BSDF ([`brtf_model::Geometry`]) is recomputed from
+    /// them on every pass: that costs a few operations per sample, while
+    /// storing it would cost as much memory traffic as reading the samples.
+    pub samples: Cow<'a, [FitSample]>,
+    /// √(weight) of sample i is `√max(wᵢ, 0) · weight_scale` (or
+    /// `weight_scale` alone with `unit_weights`), times `robust[i]` when a
+    /// robust loss has reweighted the samples.
+    pub weight_scale: f64,
+    pub unit_weights: bool,
+    pub robust: Option<Vec<f64>>,
+    /// Per value (sample × channel), the factor turning `m − y` into a
+    /// residual.
     pub factors: Vec<f64>,
     pub channels: usize,
 }
 
-impl Block {
+impl Block<'_> {
     pub(crate) fn len(&self) -> usize {
-        self.geometry.len()
+        self.samples.len()
     }
 
-    /// Recomputes the residual factors for `kind` and `floor`.
+    /// Recomputes the residual factors for `kind` and `floor` (in
+    /// parallel pieces for large blocks; each factor depends on its own
+    /// sample only, so the result does not depend on the split).
     pub(crate) fn set_factors(&mut self, kind: ResidualKind, floor: f64) {
         let channels = self.channels;
-        self.factors.clear();
-        self.factors.reserve(self.values.len());
-        for (y, &sw) in self.values.chunks_exact(channels).zip(&self.sqrt_weights) {
-            self.factors.extend(y.iter().map(|&y| match kind {
-                ResidualKind::Relative => sw / (y * y + floor * floor).sqrt(),
-                ResidualKind::Absolute | ResidualKind::Log => sw,
-            }));
+        let mut factors = std::mem::take(&mut self.factors);
+        factors.resize(self.samples.len() * channels, 0.0);
+        let this = &*self;
+        let fill = |(piece, out): (usize, &mut [f64])| {
+            let first = piece * FACTOR_PIECE;
+            let samples = &this.samples[first..first + out.len() / channels];
+            for (i, (s, out)) in samples
+                .iter()
+                .zip(out.chunks_exact_mut(channels))
+                .enumerate()
+            {
+                let sw = this.sqrt_weight(first + i, s);
+                for (o, &y) in out.iter_mut().zip(&s.value[..channels]) {
+                    *o = match kind {
+                        ResidualKind::Relative => sw / (y * y + floor * floor).sqrt(),
+                        ResidualKind::Absolute | ResidualKind::Log => sw,
+                    };
+                }
+            }
+        };
+        if self.samples.len() >= PARALLEL_ROWS {
+            factors
+                .par_chunks_mut(FACTOR_PIECE * channels)
+                .enumerate()
+                .for_each(fill);
+        } else {
+            factors
+                .chunks_mut(FACTOR_PIECE * channels)
+                .enumerate()
+                .for_each(fill);
         }
+        self.factors = factors;
+    }
+
+    /// √(weight) of sample `i`.
+    #[inline]
+    fn sqrt_weight(&self, i: usize, s: &FitSample) -> f64 {
+        let base = if self.unit_weights {
+            1.0
+        } else {
+            s.weight.max(0.0).sqrt()
+        };
+        base * self.weight_scale * self.robust.as_ref().map_or(1.0, |r| r[i])
     }
 }
+
+/// Samples per parallel piece of [`Block::set_factors`].
+const FACTOR_PIECE: usize = 8192;
 
 pub(crate) struct Problem<'a> {
     pub map: &'a ParamMap,
     pub options: EvalOptions,
     pub orientation: DVec3,
-    pub blocks: &'a [Block],
+    pub blocks: &'a [Block<'a>],
     pub channels: usize,
     pub kind: ResidualKind,
     pub floor: f64,
@@ -84,7 +133,7 @@ impl<'a> Problem<'a> {
         map: &'a ParamMap,
         config: &crate::FitConfig,
         orientation: DVec3,
-        blocks: &'a [Block],
+        blocks: &'a [Block<'a>],
         channels: usize,
         floor: f64,
     ) -> Problem<'a> {
@@ -243,7 +292,7 @@ struct Kernel<'a> {
     floor: f64,
     kind: ResidualKind,
     channels: usize,
-    blocks: &'a [Block],
+    blocks: &'a [Block<'a>],
 }
 
 // Channel loops index values, factors and the gradient together.
@@ -256,10 +305,11 @@ impl Kernel<'_> {
         let mut data = Vec::with_capacity((end - start) * channels);
         let mut sum_rel = 0.0;
         for i in start..end {
-            let f = self.bsdf.eval_geometry(&block.geometry[i]);
+            let s = &block.samples[i];
+            let f = self.bsdf.eval(block.light, s.view);
             for ch in 0..channels {
                 let row = i * channels + ch;
-                let (res, _, rel2) = self.residual(f[ch], block.values[row], block.factors[row]);
+                let (res, _, rel2) = self.residual(f[ch], s.value[ch], block.factors[row]);
                 data.push(res);
                 sum_rel += rel2;
             }
@@ -283,7 +333,8 @@ impl Kernel<'_> {
         let mut grad = Gradient::default();
         let mut sum_rel = 0.0;
         for i in start..end {
-            let g = &block.geometry[i];
+            let s = &block.samples[i];
+            let g = &self.bsdf.geometry(block.light, s.view);
             let f = if channels == 1 {
                 self.bsdf
                     .eval_geometry_channels_with_gradient::<1>(g, &mut grad)
@@ -292,8 +343,7 @@ impl Kernel<'_> {
             };
             for ch in 0..channels {
                 let row = i * channels + ch;
-                let (res, dr_dm, rel2) =
-                    self.residual(f[ch], block.values[row], block.factors[row]);
+                let (res, dr_dm, rel2) = self.residual(f[ch], s.value[ch], block.factors[row]);
                 sum_rel += rel2;
                 for (xj, &(target, dp_du)) in x.iter_mut().zip(columns) {
                     let dm_dp = match target {
