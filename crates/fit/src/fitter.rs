@@ -304,8 +304,11 @@ impl FitReport {
     }
 }
 
-/// Samples per start in the multi-start phase: enough to find a basin.
-const START_SAMPLES: usize = 1000;
+/// Samples per start in the multi-start phase (every k-th sample, plus
+/// the brightest ones): enough to find a basin.
+const START_SAMPLES: usize = 500;
+/// The brightest samples every subsample keeps, whatever its stride.
+const BRIGHT_SAMPLES: usize = 500;
 /// Samples of the polish of the best start before the fit on every
 /// sample: from its optimum, the full fit converges in three steps.
 const POLISH_SAMPLES: usize = 2000;
@@ -380,10 +383,20 @@ fn fit_many(
     let starts = prepare::starting_points(&stats, &map, config, channels);
     let mut records = Vec::new();
     let mut best: Option<(DVector<f64>, f64)> = None;
+    let share = |count: usize| count / blocks.len().max(1);
+    let bright: Vec<f64> = if starts.len() > 1 || n_points > 2 * POLISH_SAMPLES {
+        blocks
+            .iter()
+            .map(|b| prepare::bright_threshold(b, share(BRIGHT_SAMPLES)))
+            .collect()
+    } else {
+        Vec::new()
+    };
     let thin = |target: usize| -> Vec<Block> {
         blocks
             .iter()
-            .map(|b| prepare::subsample(b, target / blocks.len().max(1)))
+            .zip(&bright)
+            .map(|(b, &t)| prepare::subsample(b, share(target), t))
             .collect()
     };
     if starts.len() > 1 {
@@ -450,7 +463,7 @@ fn fit_many(
                     };
                     multipliers.push(w.sqrt());
                 }
-                b.robust = Some(multipliers);
+                b.multipliers = Some(multipliers);
                 b.set_factors(config.residual, floor);
             }
             let previous = solved.u.clone();
@@ -576,12 +589,15 @@ struct Stage {
 }
 
 impl Stage {
-    /// A start on the subsample only has to find its basin; the final fit
-    /// from the best start polishes.
+    /// A start on the subsample only has to find its basin, within a budget
+    /// of 8 (n + 1) evaluations: a start that has not converged by then
+    /// (typically one far too narrow, whose lobe misses the data) is
+    /// compared at the cost it reached. The best start is polished and fitted
+    /// to every sample afterwards.
     const START: Stage = Stage {
         tolerance: 1e-6,
         gtol: 1e-14,
-        patience: 60,
+        patience: 8,
     };
     /// The fit on every sample. From the polished start it takes three
     /// steps; the gradient test stops it after the third, where ftol alone

@@ -63,17 +63,15 @@ thread_local! {
     static SCRATCH: RefCell<Vec<f64>> = const { RefCell::new(Vec::new()) };
 }
 
-/// The value at rank `rank(len)` of the concatenated `parts` (or `None`
-/// when they are empty), by selection in the thread's scratch buffer.
-fn order_statistic<'p>(
-    parts: impl Iterator<Item = &'p [f64]>,
+/// The value at rank `rank(len)` of `values` (or `None` when there are
+/// none), by selection in the thread's scratch buffer.
+fn order_statistic(
+    values: impl Iterator<Item = f64>,
     rank: impl Fn(usize) -> usize,
 ) -> Option<f64> {
     SCRATCH.with_borrow_mut(|all| {
         all.clear();
-        for part in parts {
-            all.extend_from_slice(part);
-        }
+        all.extend(values);
         if all.is_empty() {
             return None;
         }
@@ -181,7 +179,7 @@ pub(crate) fn scan<'a>(
                 (n as f64 / weight_sum).sqrt()
             },
             unit_weights,
-            robust: None,
+            multipliers: None,
             factors: Vec::new(),
             channels,
         },
@@ -196,35 +194,63 @@ pub(crate) fn scan<'a>(
 /// 10% of the 10th percentile of the positive values of every incidence:
 /// below this, values count as noise for relative and log residuals.
 pub(crate) fn auto_floor(stats: &[ScanStats]) -> f64 {
-    let parts = stats
+    let values = stats
         .iter()
-        .flat_map(|s| s.pieces.iter().map(|p| p.positive.as_slice()));
-    let tenth = order_statistic(parts, |len| len / 10).unwrap_or(1e-5);
+        .flat_map(|s| s.pieces.iter().flat_map(|p| p.positive.iter().copied()));
+    let tenth = order_statistic(values, |len| len / 10).unwrap_or(1e-5);
     (0.1 * tenth).max(1e-12)
 }
 
-/// Every k-th sample, keeping the block's weight total.
-pub(crate) fn subsample<'a>(b: &Block<'_>, target: usize) -> Block<'a> {
+/// The channel mean of the `count`-th brightest sample of `b` (minus
+/// infinity when it has no more samples than that).
+pub(crate) fn bright_threshold(b: &Block<'_>, count: usize) -> f64 {
+    let channels = b.channels;
+    if count == 0 || count >= b.len() {
+        return f64::NEG_INFINITY;
+    }
+    let means = b
+        .samples
+        .iter()
+        .map(|s| s.value[..channels].iter().sum::<f64>() / channels as f64);
+    order_statistic(means, |len| len - count).unwrap_or(f64::NEG_INFINITY)
+}
+
+/// A subsample standing for the whole block: every sample at least as
+/// bright as `bright` (the lobe, which decides specularity and roughness,
+/// however few samples it covers) at its own weight, and every `step`-th
+/// of the others at `step` times theirs, so the cost stays an estimate of
+/// the whole block's.
+pub(crate) fn subsample<'a>(b: &Block<'_>, target: usize, bright: f64) -> Block<'a> {
     let step = (b.len() / target.max(1)).max(1);
     let channels = b.channels;
-    let picked = (0..b.len()).step_by(step);
-    let w = (step as f64).sqrt();
+    let mut samples = Vec::new();
+    let mut multipliers = Vec::new();
+    let mut factors = Vec::new();
+    let expand = (step as f64).sqrt();
+    for (i, s) in b.samples.iter().enumerate() {
+        let mean = s.value[..channels].iter().sum::<f64>() / channels as f64;
+        let m = if mean >= bright {
+            1.0
+        } else if i % step == 0 {
+            expand
+        } else {
+            continue;
+        };
+        samples.push(*s);
+        multipliers.push(m * b.multipliers.as_ref().map_or(1.0, |r| r[i]));
+        factors.extend(
+            b.factors[i * channels..(i + 1) * channels]
+                .iter()
+                .map(|k| k * m),
+        );
+    }
     Block {
         light: b.light,
-        samples: Cow::Owned(picked.clone().map(|i| b.samples[i]).collect()),
-        weight_scale: b.weight_scale * w,
+        samples: Cow::Owned(samples),
+        weight_scale: b.weight_scale,
         unit_weights: b.unit_weights,
-        robust: b
-            .robust
-            .as_ref()
-            .map(|r| picked.clone().map(|i| r[i]).collect()),
-        factors: picked
-            .flat_map(|i| {
-                b.factors[i * channels..(i + 1) * channels]
-                    .iter()
-                    .map(move |k| k * w)
-            })
-            .collect(),
+        multipliers: Some(multipliers),
+        factors,
         channels,
     }
 }
@@ -245,7 +271,8 @@ struct DataFeatures {
 
 /// The `q` quantile (by rank `⌊(len − 1) q⌋`) of the concatenated parts.
 fn quantile<'p>(parts: impl Iterator<Item = &'p [f64]>, q: f64) -> f64 {
-    order_statistic(parts, |len| ((len - 1) as f64 * q) as usize).unwrap_or(0.0)
+    let values = parts.flat_map(|p| p.iter().copied());
+    order_statistic(values, |len| ((len - 1) as f64 * q) as usize).unwrap_or(0.0)
 }
 
 fn features(s: &ScanStats) -> DataFeatures {

@@ -41,11 +41,12 @@ pub(crate) struct Block<'a> {
     /// storing it would cost as much memory traffic as reading the samples.
     pub samples: Cow<'a, [FitSample]>,
     /// √(weight) of sample i is `√max(wᵢ, 0) · weight_scale` (or
-    /// `weight_scale` alone with `unit_weights`), times `robust[i]` when a
-    /// robust loss has reweighted the samples.
+    /// `weight_scale` alone with `unit_weights`), times `multipliers[i]`
+    /// when a robust loss has reweighted the samples or a subsample stands
+    /// for more samples than it holds.
     pub weight_scale: f64,
     pub unit_weights: bool,
-    pub robust: Option<Vec<f64>>,
+    pub multipliers: Option<Vec<f64>>,
     /// Per value (sample × channel), the factor turning `m − y` into a
     /// residual.
     pub factors: Vec<f64>,
@@ -104,7 +105,7 @@ impl Block<'_> {
         } else {
             s.weight.max(0.0).sqrt()
         };
-        base * self.weight_scale * self.robust.as_ref().map_or(1.0, |r| r[i])
+        base * self.weight_scale * self.multipliers.as_ref().map_or(1.0, |r| r[i])
     }
 }
 
