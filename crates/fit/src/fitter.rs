@@ -344,11 +344,32 @@ fn fit_many(
         blocks.push(scan.block);
         stats.push(scan.stats);
     }
-    let floor = config.floor.unwrap_or_else(|| prepare::auto_floor(&stats));
+    let n_points: usize = blocks.iter().map(Block::len).sum();
+    // Three independent order statistics over every sample (the floor, the
+    // starting values, the subsamples' brightness threshold), side by side.
+    let n_blocks = blocks.len().max(1);
+    let share = move |count: usize| count / n_blocks;
+    let ((floor, starts), bright) = rayon::join(
+        || {
+            rayon::join(
+                || config.floor.unwrap_or_else(|| prepare::auto_floor(&stats)),
+                || prepare::starting_points(&stats, &map, config, channels),
+            )
+        },
+        || -> Vec<f64> {
+            if config.multistart || n_points > 2 * POLISH_SAMPLES {
+                blocks
+                    .iter()
+                    .map(|b| prepare::bright_threshold(b, share(BRIGHT_SAMPLES)))
+                    .collect()
+            } else {
+                Vec::new()
+            }
+        },
+    );
     for b in &mut blocks {
         b.set_factors(config.residual, floor);
     }
-    let n_points: usize = blocks.iter().map(Block::len).sum();
     let mut evaluations = 0;
     let solve = |blocks: &[Block], u0: DVector<f64>, stage: Stage| -> Solved {
         let problem = Problem::new(&map, config, orientation, blocks, channels, floor);
@@ -380,18 +401,8 @@ fn fit_many(
     };
 
     // Multi-start on a subsample, then the full fit from the best start.
-    let starts = prepare::starting_points(&stats, &map, config, channels);
     let mut records = Vec::new();
     let mut best: Option<(DVector<f64>, f64)> = None;
-    let share = |count: usize| count / blocks.len().max(1);
-    let bright: Vec<f64> = if starts.len() > 1 || n_points > 2 * POLISH_SAMPLES {
-        blocks
-            .iter()
-            .map(|b| prepare::bright_threshold(b, share(BRIGHT_SAMPLES)))
-            .collect()
-    } else {
-        Vec::new()
-    };
     let thin = |target: usize| -> Vec<Block> {
         blocks
             .iter()
