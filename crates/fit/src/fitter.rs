@@ -306,9 +306,9 @@ impl FitReport {
 
 /// Samples per start in the multi-start phase (every k-th sample, plus
 /// the brightest ones): enough to find a basin.
-const START_SAMPLES: usize = 500;
+const START_SAMPLES: usize = 250;
 /// The brightest samples every subsample keeps, whatever its stride.
-const BRIGHT_SAMPLES: usize = 500;
+const BRIGHT_SAMPLES: usize = 250;
 /// Samples of the polish of the best start before the fit on every
 /// sample: from its optimum, the full fit converges in three steps.
 const POLISH_SAMPLES: usize = 2000;

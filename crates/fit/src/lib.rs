@@ -8,9 +8,14 @@
 //! * Parameters are fitted in unconstrained coordinates: a logistic maps
 //!   each to its physical box, `exp` keeps the free scale positive.
 //! * The Jacobian is exact, from brtf-model's analytic gradients.
+//! * Levenberg-Marquardt runs on the problem compressed to n + 1 rows (the
+//!   triangle of `[J | r]`, from its Gram matrix accumulated in parallel
+//!   chunks): the same steps as on the full problem, without storing or
+//!   factorising the m × n Jacobian.
 //! * Starting values come from the data (diffuse floor, peak height and
-//!   width); a multi-start over roughness on a subsample escapes the local
-//!   minima a single start falls into.
+//!   width); a multi-start over roughness on a subsample that keeps every
+//!   bright sample (the lobe) escapes the local minima a single start
+//!   falls into.
 //! * Standard errors are `s² (JᵀJ)⁻¹`, with `s² = Σr²/(m − n)`, mapped to
 //!   physical units through the bound transform.
 //!
