@@ -68,6 +68,8 @@ pub struct Bsdf {
     fresnel: bool,
     anisotropic: bool,
     metal: bool,
+    /// `trans` or `trans2`: light from behind can reach the viewer.
+    transmitting: bool,
     frame_u: DVec3,
     frame_v: DVec3,
 }
@@ -168,6 +170,7 @@ impl Bsdf {
             fresnel: variant == Variant::Radiance && pure && spec >= FRESNEL_THRESHOLD,
             anisotropic,
             metal: kind.is_metal(),
+            transmitting: kind.is_transmitting(),
             frame_u,
             frame_v,
         }
@@ -235,7 +238,8 @@ impl Bsdf {
         };
         if g.light_cosine > FTINY {
             self.reflection_geometry(l, v, &mut g);
-        } else if g.light_cosine < -FTINY {
+        } else if g.light_cosine < -FTINY && self.transmitting {
+            // Opaque types return 0 here whatever their arguments.
             self.transmission_geometry(l, v, &mut g);
         }
         g
