@@ -272,6 +272,11 @@ fn ggx_set_converges_everywhere_with_no_parameter_at_a_bound() {
         // The mismatch shows: a Gaussian cannot follow GGX tails.
         assert!(r.rms_rel > 0.05, "θ={} rms_rel {}", r.theta_in, r.rms_rel);
     }
+    // fit.json holds every number exactly: parsing and writing it again
+    // gives the same text, digit for digit.
+    let text = std::fs::read_to_string(dir.path().join("fit/fit.json")).unwrap();
+    let again = serde_json::to_string_pretty(&serde_json::from_str::<FitResult>(&text).unwrap());
+    assert_eq!(again.unwrap().trim_end(), text.trim_end());
     let table = result.table.expect("five incidences give a table");
     assert_eq!(table.theta_in, vec![0.0, 15.0, 30.0, 45.0, 60.0]);
     let csv = std::fs::read_to_string(dir.path().join("fit/params.csv")).unwrap();
