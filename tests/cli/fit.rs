@@ -462,3 +462,29 @@ fn bad_input_is_a_clear_error_and_writes_nothing() {
         serde_json::from_str(&std::fs::read_to_string(out.join("fit.json")).unwrap()).unwrap();
     assert!(result.table.is_none());
 }
+
+#[test]
+fn results_do_not_depend_on_the_thread_count() {
+    // A real 122 000-sample scan, so every parallel path is taken: the
+    // scan of the samples, the chunked passes, the multi-start.
+    let runs: Vec<String> = ["1", "2"]
+        .iter()
+        .map(|jobs| {
+            let dir = temp_dir();
+            fit(
+                dir.path(),
+                &[real_scan("golden_paper.txt")],
+                &[
+                    "--model",
+                    "metal",
+                    "--jobs",
+                    jobs,
+                    "--no-export",
+                    "--no-plots",
+                ],
+            );
+            std::fs::read_to_string(dir.path().join("fit/params.csv")).unwrap()
+        })
+        .collect();
+    assert_eq!(runs[0], runs[1]);
+}
