@@ -50,6 +50,7 @@ fn report(kind: MaterialKind, theta_in: f64, args: &[f64]) -> FitReport {
                 name: (*name).into(),
                 value,
                 stderr: 1e-3,
+                stderr_robust: 1e-3,
                 at_bound: false,
                 fixed: false,
             })

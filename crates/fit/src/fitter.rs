@@ -235,6 +235,12 @@ pub struct ParamEstimate {
     pub value: f64,
     /// Standard error from s²(JᵀJ)⁻¹ (0 for a parameter held fixed).
     pub stderr: f64,
+    /// Heteroscedasticity-consistent standard error from the sandwich
+    /// `m/(m−n) (JᵀJ)⁻¹ (Σ rᵢ² Jᵢ Jᵢᵀ) (JᵀJ)⁻¹`, which does not assume
+    /// equal residual variances (absent in fit.json files written before
+    /// it existed: 0).
+    #[serde(default)]
+    pub stderr_robust: f64,
     /// Ended at a physical bound (its standard error is then meaningless).
     pub at_bound: bool,
     /// Held fixed rather than fitted.
@@ -375,6 +381,7 @@ fn fit_many(
         let problem = Problem::new(&map, config, orientation, blocks, channels, floor);
         let mut problem = problem;
         problem.u = u0.clone();
+        problem.with_meat = stage.meat;
         let (problem, report) = LevenbergMarquardt::new()
             .with_ftol(stage.tolerance)
             .with_xtol(stage.tolerance)
@@ -509,24 +516,33 @@ fn fit_many(
     let jacobian = final_pass.jacobian;
     let dof = m_res.saturating_sub(map.len()).max(1) as f64;
     let s2 = 2.0 * cost / dof;
-    let stderr_u = (jacobian.transpose() * &jacobian)
-        .try_inverse()
-        .map(|inv| {
-            (0..map.len())
-                .map(|i| (s2 * inv[(i, i)]).max(0.0).sqrt())
-                .collect::<Vec<f64>>()
-        })
-        .unwrap_or_else(|| vec![f64::NAN; map.len()]);
-
+    let n = map.len();
+    let inverse = (jacobian.transpose() * &jacobian).try_inverse();
+    let stderr_u: Vec<f64> = match &inverse {
+        Some(inv) => (0..n).map(|i| (s2 * inv[(i, i)]).max(0.0).sqrt()).collect(),
+        None => vec![f64::NAN; n],
+    };
+    let robust_u: Vec<f64> = match (&inverse, &final_pass.meat) {
+        (Some(inv), Some(meat)) => {
+            let sandwich = inv * meat * inv * (m_res as f64 / dof);
+            (0..n).map(|i| sandwich[(i, i)].max(0.0).sqrt()).collect()
+        }
+        _ => vec![f64::NAN; n],
+    };
     // Report every material argument by name.
     let args = material.args().to_vec();
     let mut params = Vec::new();
     let mut warnings = Vec::new();
     for (a, name) in config.kind.param_names().iter().enumerate() {
         let slot = map.slot_of_arg(a);
-        let (stderr, at_bound, fixed) = match slot {
-            Some(i) => (stderr_u[i] * dp[i].abs(), map.at_bound(i, p[i]), false),
-            None => (0.0, false, true),
+        let (stderr, stderr_robust, at_bound, fixed) = match slot {
+            Some(i) => (
+                stderr_u[i] * dp[i].abs(),
+                robust_u[i] * dp[i].abs(),
+                map.at_bound(i, p[i]),
+                false,
+            ),
+            None => (0.0, 0.0, false, true),
         };
         if at_bound {
             warnings.push(format!("{name} = {:.6} ended at a bound", args[a]));
@@ -535,6 +551,7 @@ fn fit_many(
             name: (*name).into(),
             value: args[a],
             stderr,
+            stderr_robust,
             at_bound,
             fixed,
         });
@@ -544,12 +561,27 @@ fn fit_many(
             name: "scale".into(),
             value: scale,
             stderr: stderr_u[i] * dp[i].abs(),
+            stderr_robust: robust_u[i] * dp[i].abs(),
             at_bound: map.at_bound(i, p[i]),
             fixed: false,
         });
         warnings.push(
             "free scale: the colour is fixed at 1, so `scale` is scale × colour; give the beam integral or a known reflectance for absolute colour".into(),
         );
+    }
+    // Unequal residual variances (multiplicative noise with absolute
+    // residuals, or a model that misses the data's shape) make s²(JᵀJ)⁻¹
+    // too small; say so when the sandwich disagrees by more than 2×.
+    let understated: Vec<String> = params
+        .iter()
+        .filter(|p| !p.fixed && !p.at_bound && p.stderr_robust > 2.0 * p.stderr)
+        .map(|p| format!("{} ({:.1}×)", p.name, p.stderr_robust / p.stderr))
+        .collect();
+    if !understated.is_empty() {
+        warnings.push(format!(
+            "the residuals' variance is not uniform, so the standard errors understate the uncertainty of {}; use stderr_robust in fit.json, or --residual log for multiplicative noise",
+            understated.join(", ")
+        ));
     }
     if args[3] < 1e-4 {
         warnings
@@ -597,6 +629,9 @@ struct Stage {
     gtol: f64,
     /// Evaluation budget in units of (parameters + 1).
     patience: usize,
+    /// Accumulate the sandwich's middle term (only the final fit reports
+    /// standard errors).
+    meat: bool,
 }
 
 impl Stage {
@@ -609,6 +644,7 @@ impl Stage {
         tolerance: 1e-6,
         gtol: 1e-14,
         patience: 8,
+        meat: false,
     };
     /// The fit on every sample. From the polished start it takes three
     /// steps; the gradient test stops it after the third, where ftol alone
@@ -617,6 +653,7 @@ impl Stage {
         tolerance: 1e-12,
         gtol: 1e-6,
         patience: 200,
+        meat: true,
     };
 }
 

@@ -122,6 +122,8 @@ pub(crate) struct Problem<'a> {
     pub floor: f64,
     pub u: DVector<f64>,
     pub evaluations: Cell<usize>,
+    /// Also accumulate `Σ rᵢ² Jᵢ Jᵢᵀ` for the sandwich standard errors.
+    pub with_meat: bool,
     /// Every compressed evaluation so far, by point: LM asks for the
     /// Jacobian of its last accepted point, and the fit's final report
     /// needs the triangle at the solution; neither needs a new pass.
@@ -148,6 +150,7 @@ impl<'a> Problem<'a> {
             floor,
             u: DVector::zeros(map.len()),
             evaluations: Cell::new(0),
+            with_meat: false,
             history: RefCell::new(Vec::new()),
         }
     }
@@ -182,12 +185,17 @@ impl<'a> Problem<'a> {
     /// `Jᵀr`, the same column norms and the same linearised model
     /// `‖r + J δ‖²` as the full problem. Levenberg-Marquardt therefore
     /// takes exactly the same steps on it, while each of its iterations
-    /// factorises an (n + 1) × n matrix instead of an m × n one. The QR is
-    /// computed chunk by chunk as the samples are evaluated (TSQR), so the
-    /// m × n Jacobian is never stored.
+    /// factorises an (n + 1) × n matrix instead of an m × n one. The
+    /// triangle comes from the Gram matrix of `A`, accumulated chunk by
+    /// chunk as the samples are evaluated, so the m × n Jacobian is never
+    /// stored (see `augmented_cholesky`).
     pub(crate) fn compressed(&self, u: &DVector<f64>) -> Option<Compressed> {
         match self.pass::<true>(u)? {
-            Pass::Compressed { triangle, rms_rel } => {
+            Pass::Compressed {
+                triangle,
+                rms_rel,
+                meat,
+            } => {
                 let n = self.map.len();
                 let residuals = DVector::from_column_slice(&triangle[n * (n + 1)..]);
                 let jacobian = DMatrix::from_column_slice(n + 1, n, &triangle[..n * (n + 1)]);
@@ -195,6 +203,7 @@ impl<'a> Problem<'a> {
                     residuals,
                     jacobian,
                     rms_rel,
+                    meat,
                 })
             }
             Pass::Full { .. } => None,
@@ -236,20 +245,30 @@ impl<'a> Problem<'a> {
             channels: self.channels,
             blocks: self.blocks,
         };
+        let with_meat = self.with_meat;
         let run_chunk = |chunk: &Chunk| -> ChunkResult {
             if !COMPRESS {
                 return kernel.residuals(*chunk);
             }
-            match width {
-                2 => kernel.gram::<2>(*chunk),
-                3 => kernel.gram::<3>(*chunk),
-                4 => kernel.gram::<4>(*chunk),
-                5 => kernel.gram::<5>(*chunk),
-                6 => kernel.gram::<6>(*chunk),
-                7 => kernel.gram::<7>(*chunk),
-                8 => kernel.gram::<8>(*chunk),
-                9 => kernel.gram::<9>(*chunk),
-                10 => kernel.gram::<10>(*chunk),
+            match (width, with_meat) {
+                (2, false) => kernel.gram::<2, false>(*chunk),
+                (2, true) => kernel.gram::<2, true>(*chunk),
+                (3, false) => kernel.gram::<3, false>(*chunk),
+                (3, true) => kernel.gram::<3, true>(*chunk),
+                (4, false) => kernel.gram::<4, false>(*chunk),
+                (4, true) => kernel.gram::<4, true>(*chunk),
+                (5, false) => kernel.gram::<5, false>(*chunk),
+                (5, true) => kernel.gram::<5, true>(*chunk),
+                (6, false) => kernel.gram::<6, false>(*chunk),
+                (6, true) => kernel.gram::<6, true>(*chunk),
+                (7, false) => kernel.gram::<7, false>(*chunk),
+                (7, true) => kernel.gram::<7, true>(*chunk),
+                (8, false) => kernel.gram::<8, false>(*chunk),
+                (8, true) => kernel.gram::<8, true>(*chunk),
+                (9, false) => kernel.gram::<9, false>(*chunk),
+                (9, true) => kernel.gram::<9, true>(*chunk),
+                (10, false) => kernel.gram::<10, false>(*chunk),
+                (10, true) => kernel.gram::<10, true>(*chunk),
                 _ => unreachable!("at most {} parameters", MAX_WIDTH - 1),
             }
         };
@@ -272,15 +291,25 @@ impl<'a> Problem<'a> {
                 residuals: DVector::from_vec(residuals),
             });
         }
-        // Sum the chunks' Gram matrices in chunk order, then factorise.
-        let mut gram = vec![0.0; width * width];
+        // Sum the chunks' Gram matrices (and meat) in chunk order, then
+        // factorise.
+        let mut sums = vec![0.0; parts[0].data.len()];
         for p in &parts {
-            for (total, value) in gram.iter_mut().zip(&p.data) {
+            for (total, value) in sums.iter_mut().zip(&p.data) {
                 *total += value;
             }
         }
-        let triangle = augmented_cholesky(&gram, width);
-        Some(Pass::Compressed { triangle, rms_rel })
+        let triangle = augmented_cholesky(&sums[..width * width], width);
+        let meat = self.with_meat.then(|| {
+            // W × W layout, the first n × n used; upper triangle filled.
+            let m = &sums[width * width..];
+            DMatrix::from_fn(n, n, |a, b| m[a.min(b) * width + a.max(b)])
+        });
+        Some(Pass::Compressed {
+            triangle,
+            rms_rel,
+            meat,
+        })
     }
 }
 
@@ -325,11 +354,12 @@ impl Kernel<'_> {
     /// The upper triangle of `[J | r]ᵀ[J | r]` of one chunk (row-major,
     /// `W × W`), for `W − 1` parameters; the fixed width lets the compiler
     /// unroll the accumulation.
-    fn gram<const W: usize>(&self, (b, start, end): Chunk) -> ChunkResult {
+    fn gram<const W: usize, const MEAT: bool>(&self, (b, start, end): Chunk) -> ChunkResult {
         let block = &self.blocks[b];
         let channels = self.channels;
         let columns: &[(Target, f64)] = &self.columns[..W - 1];
         let mut gram = [[0.0; W]; W];
+        let mut meat = [[0.0; W]; W];
         let mut x = [0.0; W];
         let mut grad = Gradient::default();
         let mut sum_rel = 0.0;
@@ -362,9 +392,20 @@ impl Kernel<'_> {
                         gram[a][b] += x[a] * x[b];
                     }
                 }
+                if MEAT {
+                    let r2 = res * res;
+                    for a in 0..W - 1 {
+                        for b in a..W - 1 {
+                            meat[a][b] += r2 * x[a] * x[b];
+                        }
+                    }
+                }
             }
         }
-        let data: Vec<f64> = gram.iter().flatten().copied().collect();
+        let mut data: Vec<f64> = gram.iter().flatten().copied().collect();
+        if MEAT {
+            data.extend(meat.iter().flatten());
+        }
         ChunkResult {
             finite: data.iter().all(|v| v.is_finite()),
             data,
@@ -447,8 +488,14 @@ struct ChunkResult {
 }
 
 enum Pass {
-    Full { residuals: DVector<f64> },
-    Compressed { triangle: Vec<f64>, rms_rel: f64 },
+    Full {
+        residuals: DVector<f64>,
+    },
+    Compressed {
+        triangle: Vec<f64>,
+        rms_rel: f64,
+        meat: Option<DMatrix<f64>>,
+    },
 }
 
 /// The problem at one point, compressed to n + 1 rows (see
@@ -459,11 +506,13 @@ pub(crate) struct Compressed {
     /// `[R; 0]`, (n + 1) × n: `JᵀJ = RᵀR`.
     pub jacobian: DMatrix<f64>,
     pub rms_rel: f64,
+    /// `Σ rᵢ² Jᵢ Jᵢᵀ` (n × n), the middle of the sandwich covariance, when
+    /// the problem was asked for it.
+    pub meat: Option<DMatrix<f64>>,
 }
 
-/// Samples per chunk of a pass. A chunk's [J | r] (2048 × 4 doubles for
-/// three parameters) stays below the allocator's 128 KiB mmap threshold,
-/// which would otherwise cost fresh zeroed pages on every pass.
+/// Samples per chunk of a pass: the unit of parallel work and of the
+/// fixed summation order.
 const CHUNK: usize = 2048;
 /// Passes with at least this many residuals run their chunks in parallel.
 const PARALLEL_ROWS: usize = 16_384;

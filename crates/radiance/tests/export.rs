@@ -24,6 +24,7 @@ fn report(kind: MaterialKind, theta_in: f64, args: &[f64]) -> FitReport {
                 name: (*name).into(),
                 value,
                 stderr: 2e-3,
+                stderr_robust: 2e-3,
                 at_bound: false,
                 fixed: false,
             })
