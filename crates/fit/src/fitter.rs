@@ -247,6 +247,18 @@ pub struct ParamEstimate {
     pub fixed: bool,
 }
 
+impl ParamEstimate {
+    /// The larger of the two standard errors (a non-finite one is
+    /// ignored): the one to show when the residuals' variance may not be
+    /// uniform.
+    pub fn uncertainty(&self) -> f64 {
+        [self.stderr, self.stderr_robust]
+            .into_iter()
+            .filter(|v| v.is_finite())
+            .fold(f64::NAN, f64::max)
+    }
+}
+
 /// One starting point of the multi-start and where it ended.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct StartRecord {

@@ -123,7 +123,7 @@ fn param_cell(r: &FitReport, name: &str) -> String {
             "{} <span class=\"bound\" title=\"at a bound: the standard error is meaningless\">!</span>",
             fmt6(p.value)
         ),
-        Some(p) => format!("{} ± {}", fmt6(p.value), fmt_err(p.stderr)),
+        Some(p) => format!("{} ± {}", fmt6(p.value), fmt_err(p.uncertainty())),
     }
 }
 

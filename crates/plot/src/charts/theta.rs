@@ -229,8 +229,8 @@ impl ParamsChart<'_> {
         for (_, name, _) in &panel.series {
             for r in &result.incidences {
                 if let Some(p) = param(r, name) {
-                    let se = if p.stderr.is_finite() && !p.at_bound {
-                        p.stderr
+                    let se = if p.uncertainty().is_finite() && !p.at_bound {
+                        p.uncertainty()
                     } else {
                         0.0
                     };
@@ -287,8 +287,9 @@ impl ParamsChart<'_> {
                 .filter_map(|r| param(r, name).map(|p| (r.theta_in, p)))
                 .collect();
             for (t, p) in &points {
-                if p.stderr.is_finite() && p.stderr > 0.0 && !p.at_bound {
-                    let (lo, hi) = (p.value - p.stderr, p.value + p.stderr);
+                let se = p.uncertainty();
+                if se.is_finite() && se > 0.0 && !p.at_bound {
+                    let (lo, hi) = (p.value - se, p.value + se);
                     let style = colour.stroke_width(1);
                     for seg in [
                         vec![(*t, lo), (*t, hi)],
