@@ -646,13 +646,18 @@ fn summary(result: &FitResult, out: &Path) -> String {
     let _ = writeln!(s, "(! = at a bound, = = held fixed)");
     let mut warned = false;
     let global = result.global.iter().filter(|_| result.incidences.len() > 1);
-    for r in result.incidences.iter().chain(global) {
+    let labelled = result
+        .incidences
+        .iter()
+        .map(|r| (r, format!("{} (θ_in {})", r.source, r.theta_in)))
+        .chain(global.map(|r| (r, "all incidences".to_string())));
+    for (r, label) in labelled {
         for w in &r.warnings {
             if !warned {
                 let _ = writeln!(s, "\nwarnings:");
                 warned = true;
             }
-            let _ = writeln!(s, "  {} (θ_in {}): {w}", r.source, r.theta_in);
+            let _ = writeln!(s, "  {label}: {w}");
         }
     }
     if let Some(g) = &result.global {
