@@ -128,6 +128,19 @@ fn recovers_exact_parameters_without_noise() {
     }
 }
 
+/// 2 % noise, noise floor, blind spot, holder gap, noisy back rows; point
+/// apertures (finite ones widen the lobe: see docs/fitting.md).
+const NOISY: &[&str] = &[
+    "--noise",
+    "0.02",
+    "--noise-floor",
+    "1e-4",
+    "--source-aperture",
+    "0",
+    "--detector-aperture",
+    "0",
+];
+
 #[test]
 fn recovers_parameters_within_three_standard_errors_at_two_percent_noise() {
     let cases: [(&str, &str, &[f64], &[&str]); 5] = [
@@ -164,18 +177,7 @@ fn recovers_parameters_within_three_standard_errors_at_two_percent_noise() {
     ];
     for (model, material, truth, synth_args) in cases {
         let dir = temp_dir();
-        // 2 % noise, noise floor, blind spot, holder gap, noisy back rows;
-        // point apertures (finite ones widen the lobe: see docs/fitting.md).
-        let mut args = vec![
-            "--noise",
-            "0.02",
-            "--noise-floor",
-            "1e-4",
-            "--source-aperture",
-            "0",
-            "--detector-aperture",
-            "0",
-        ];
+        let mut args = NOISY.to_vec();
         args.extend_from_slice(synth_args);
         let files = synth(dir.path(), material, &args);
         let result = fit(
@@ -507,17 +509,7 @@ fn robust_standard_errors_hold_for_the_default_absolute_residuals() {
         ),
     ] {
         let dir = temp_dir();
-        let args = [
-            "--noise",
-            "0.02",
-            "--noise-floor",
-            "1e-4",
-            "--source-aperture",
-            "0",
-            "--detector-aperture",
-            "0",
-        ];
-        let files = synth(dir.path(), material, &args);
+        let files = synth(dir.path(), material, NOISY);
         let result = fit(
             dir.path(),
             &files,

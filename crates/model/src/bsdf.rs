@@ -74,6 +74,17 @@ pub struct Bsdf {
     frame_v: DVec3,
 }
 
+/// The split of [`Bsdf::view_split`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ViewSplit {
+    /// Specularity after the view-side Fresnel estimate.
+    pub spec: f64,
+    /// Transmitted fraction `a_t (1 − spec)`.
+    pub transmitted: f64,
+    /// Diffuse reflection fraction `1 − transmitted − spec`.
+    pub diffuse: f64,
+}
+
 /// What the view direction alone fixes: the effective specularity and the
 /// split into diffuse reflection, diffuse and specular transmission.
 #[derive(Debug, Clone, Copy)]
@@ -211,7 +222,7 @@ impl Bsdf {
     #[inline]
     pub fn eval(&self, l: DVec3, v: DVec3) -> Rgb {
         let mut unused = Gradient::default();
-        self.eval_impl::<false, 3>(&self.geometry(l, v), &mut unused)
+        self.eval_impl::<false, 3, true>(&self.geometry(l, v), &mut unused)
     }
 
     /// BSDF and its gradient with respect to every real argument.
@@ -219,7 +230,29 @@ impl Bsdf {
     #[inline]
     pub fn eval_with_gradient(&self, l: DVec3, v: DVec3, grad: &mut Gradient) -> Rgb {
         *grad = Gradient::default();
-        self.eval_impl::<true, 3>(&self.geometry(l, v), grad)
+        self.eval_impl::<true, 3, true>(&self.geometry(l, v), grad)
+    }
+
+    /// The diffuse part of `f(l, v)`: `C R_d/π` in front (`C T_d/π`
+    /// behind), with the Fresnel and variant details of [`Bsdf::eval`]; the
+    /// rest of `f` is the specular lobes. A renderer that traces the
+    /// specular rays and the diffuse ambient separately needs the split.
+    #[inline]
+    pub fn eval_diffuse(&self, l: DVec3, v: DVec3) -> Rgb {
+        let mut unused = Gradient::default();
+        self.eval_impl::<false, 3, false>(&self.geometry(l, v), &mut unused)
+    }
+
+    /// How light leaving towards a view at cosine `view_cosine` divides
+    /// between the specular, transmitted and diffuse-reflected parts (the
+    /// cosine is clamped as rtrace does).
+    pub fn view_split(&self, view_cosine: f64) -> ViewSplit {
+        let v = self.view_coefficients(view_cosine.max(MIN_VIEW_COSINE));
+        ViewSplit {
+            spec: v.spec,
+            transmitted: v.transmitted,
+            diffuse: v.diffuse,
+        }
     }
 
     /// The argument-free part of `f(l, v)`; see [`Geometry`].
@@ -250,14 +283,14 @@ impl Bsdf {
     #[inline]
     pub fn eval_geometry(&self, g: &Geometry) -> Rgb {
         let mut unused = Gradient::default();
-        self.eval_impl::<false, 3>(g, &mut unused)
+        self.eval_impl::<false, 3, true>(g, &mut unused)
     }
 
     /// `f` and its gradient for directions prepared by [`Bsdf::geometry`].
     #[inline]
     pub fn eval_geometry_with_gradient(&self, g: &Geometry, grad: &mut Gradient) -> Rgb {
         *grad = Gradient::default();
-        self.eval_impl::<true, 3>(g, grad)
+        self.eval_impl::<true, 3, true>(g, grad)
     }
 
     /// Like [`Bsdf::eval_geometry_with_gradient`] for the first `CH`
@@ -273,7 +306,7 @@ impl Bsdf {
         for d in &mut grad.d {
             d[..CH].fill(0.0);
         }
-        self.eval_impl::<true, CH>(g, grad)
+        self.eval_impl::<true, CH, true>(g, grad)
     }
 
     fn view_coefficients(&self, view_cosine: f64) -> ViewCoefficients {
@@ -326,7 +359,7 @@ impl Bsdf {
     }
 
     #[inline(always)]
-    fn eval_impl<const GRAD: bool, const CH: usize>(
+    fn eval_impl<const GRAD: bool, const CH: usize, const SPECULAR: bool>(
         &self,
         g: &Geometry,
         grad: &mut Gradient,
@@ -355,7 +388,7 @@ impl Bsdf {
         let lay = self.layout;
         let c = self.color;
         if light_cosine > FTINY {
-            self.add_reflection::<GRAD, CH>(g, &view, light_fresnel, &mut f, grad);
+            self.add_reflection::<GRAD, CH, SPECULAR>(g, &view, light_fresnel, &mut f, grad);
         } else if light_cosine < -FTINY {
             // Diffuse transmission C·Td/π.
             // (td > 0 only for the transmitting types, which have both indices.)
@@ -375,7 +408,7 @@ impl Bsdf {
                     }
                 }
             }
-            if !self.pure && ts > FTINY {
+            if SPECULAR && !self.pure && ts > FTINY {
                 self.add_transmission::<GRAD, CH>(g, &view, ts, &mut f, grad);
             }
         }
@@ -384,7 +417,7 @@ impl Bsdf {
 
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn add_reflection<const GRAD: bool, const CH: usize>(
+    fn add_reflection<const GRAD: bool, const CH: usize, const SPECULAR: bool>(
         &self,
         g: &Geometry,
         view: &ViewCoefficients,
@@ -433,7 +466,7 @@ impl Bsdf {
         } else {
             view.spec > FTINY
         };
-        if self.pure || !spec_on {
+        if !SPECULAR || self.pure || !spec_on {
             return;
         }
         let lobe = self.reflection_lobe(g);

@@ -31,7 +31,7 @@ mod material;
 mod options;
 
 pub use albedo::{Albedo, albedo, gauss_legendre_rule};
-pub use bsdf::{Bsdf, Geometry, Gradient, Rgb};
+pub use bsdf::{Bsdf, Geometry, Gradient, Rgb, ViewSplit};
 pub use kind::{MaterialKind, Variant};
 pub use material::{FTINY, MAX_ARGS, Material, ModelError};
 pub use options::{EvalOptions, FRESNEL_K_CLASSIC, FRESNEL_K_PYRADIANCE};

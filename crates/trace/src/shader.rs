@@ -17,13 +17,12 @@
 //! with the whole `f`) from what other rays bring: the specular rays
 //! (`ρ_s R(m)`, `τ_s R(t)`) and the diffuse ambient (`ρ_a A/π`). For those
 //! the shader splits `f = f_d + f_s`: [`Shader::diffuse`] is the diffuse
-//! part `C R_d/π` (and `C T_d/π` behind), written here from the formulas
-//! of `docs/models.md` for every type and variant; `f_s = f − f_d`.
+//! part `C R_d/π` (and `C T_d/π` behind), brtf-model's
+//! [`Bsdf::eval_diffuse`]; `f_s = f − f_d`.
 
 use brtf_fit::{ParamTable, TableError};
 use brtf_model::{Bsdf, EvalOptions, FTINY, Material, MaterialKind, Rgb, Variant};
 use glam::DVec3;
-use std::f64::consts::PI;
 
 use crate::frame::Frame;
 use crate::sampling::{ReflectionLobe, TransmissionLobe};
@@ -31,8 +30,6 @@ use crate::sampling::{ReflectionLobe, TransmissionLobe};
 /// Grid step (degrees) of a θ_in-table shader.
 pub const TABLE_STEP_DEG: f64 = 0.25;
 
-/// Rtrace's Fresnel switch (FRESTHRESH).
-const FRESNEL_THRESHOLD: f64 = 0.017999;
 /// rtrace clamps the view cosine (`pdot >= .001`).
 const MIN_VIEW_COSINE: f64 = 0.001;
 
@@ -61,15 +58,11 @@ struct Entry {
     /// normal (rtrace's arbitrary tangent and mean roughness).
     degenerate: Option<Bsdf>,
     kind: MaterialKind,
-    color: Rgb,
+    /// The specularity argument (before any Fresnel estimate).
     spec: f64,
-    trans: f64,
     tspec: f64,
     alpha2: (f64, f64),
-    pure: bool,
-    fresnel: bool,
     variant: Variant,
-    fresnel_k: f64,
 }
 
 impl Entry {
@@ -80,30 +73,24 @@ impl Entry {
         let degenerate = kind
             .is_anisotropic()
             .then(|| Material::new(kind, args, Some(DVec3::Z)).expect("valid material"));
-        let (trans, tspec) = match kind {
-            MaterialKind::Trans => (args[5], args[6]),
-            MaterialKind::Trans2 => (args[6], args[7]),
-            _ => (0.0, 0.0),
+        let tspec = match kind {
+            MaterialKind::Trans => args[6],
+            MaterialKind::Trans2 => args[7],
+            _ => 0.0,
         };
         let alpha2 = if kind.is_anisotropic() {
             (args[4] * args[4], args[5] * args[5])
         } else {
             (args[4] * args[4], args[4] * args[4])
         };
-        let pure = !kind.is_anisotropic() && alpha2.0 <= FTINY;
         Entry {
             bsdf: Bsdf::new(&along, options),
             degenerate: degenerate.map(|m| Bsdf::new(&m, options)),
             kind,
-            color: material.color(),
             spec: material.spec(),
-            trans,
             tspec,
             alpha2,
-            pure,
-            fresnel: options.variant == Variant::Radiance && pure && args[3] >= FRESNEL_THRESHOLD,
             variant: options.variant,
-            fresnel_k: options.fresnel_k,
         }
     }
 
@@ -115,87 +102,37 @@ impl Entry {
         }
     }
 
-    #[inline]
-    fn fresnel_estimate(&self, c: f64) -> f64 {
-        (-5.85 * c).exp() - self.fresnel_k
-    }
-
-    /// Effective specularity, transmitted fraction and diffuse fraction for
-    /// a view cosine (brtf-model's view set-up).
-    #[inline]
-    fn view_split(&self, view_cosine: f64) -> (f64, f64, f64) {
-        let spec = if self.fresnel {
-            self.spec + self.fresnel_estimate(view_cosine) * (1.0 - self.spec)
-        } else if self.variant == Variant::Ward1992 && !self.kind.is_metal() {
-            self.spec + (-6.0 * view_cosine).exp() * (1.0 - self.spec)
-        } else {
-            self.spec
-        };
-        let t = self.trans * (1.0 - spec);
-        (spec, t, 1.0 - t - spec)
-    }
-
     /// The diffuse part of `f(l, v)`, `v.z ≥ 0`.
+    #[inline]
     fn diffuse(&self, l: DVec3, v: DVec3) -> Rgb {
-        let view_cosine = v.z.max(MIN_VIEW_COSINE);
-        let (_, t, rd) = self.view_split(view_cosine);
-        let wrong_side = if l.z < 0.0 {
-            t <= FTINY
-        } else {
-            t >= 1.0 - FTINY
-        };
-        if wrong_side {
-            return [0.0; 3];
-        }
-        let td = t - t * self.tspec;
-        let light_fresnel = if self.fresnel && (rd > FTINY || td > FTINY) {
-            1.0 - self.fresnel_estimate(l.z.abs())
-        } else {
-            1.0
-        };
-        let c = self.color;
-        if l.z > FTINY {
-            if self.kind.is_metal() && self.variant == Variant::Ward1992 {
-                let e = (-6.0 * view_cosine).exp();
-                return std::array::from_fn(|k| {
-                    let s = c[k] * self.spec + (1.0 - c[k] * self.spec) * e;
-                    c[k] * (1.0 - s) / PI
-                });
-            }
-            if rd > FTINY {
-                let k = rd * light_fresnel / PI;
-                return c.map(|x| x * k);
-            }
-        } else if l.z < -FTINY && td > FTINY {
-            let k = td * light_fresnel / PI;
-            return c.map(|x| x * k);
-        }
-        [0.0; 3]
+        self.bsdf.eval_diffuse(l, v)
     }
 
     fn lobes(&self, v: DVec3, degenerate: bool) -> Lobes {
         let view_cosine = v.z.max(MIN_VIEW_COSINE);
-        let (spec, t, rd) = self.view_split(view_cosine);
+        let split = self.bsdf.view_split(view_cosine);
+        let (spec, t, rd) = (split.spec, split.transmitted, split.diffuse);
         let ts = t * self.tspec;
         let (mut wu, mut wv) = self.alpha2;
         if degenerate {
             let mean = 0.5 * (wu + wv);
             (wu, wv) = (mean, mean);
         }
-        let spec_on = if self.kind.is_metal() && self.variant == Variant::Ward1992 {
+        let ward_metal = self.kind.is_metal() && self.variant == Variant::Ward1992;
+        let spec_on = if ward_metal {
             self.spec > FTINY
         } else {
             spec > FTINY
         };
+        let pure = self.bsdf.is_pure();
         let reflecting = t < 1.0 - FTINY;
         let transmitting = t > FTINY;
         Lobes {
-            reflect: (!self.pure && spec_on && reflecting).then_some(ReflectionLobe { wu, wv }),
-            transmit: (!self.pure && ts > FTINY && transmitting)
+            reflect: (!pure && spec_on && reflecting).then_some(ReflectionLobe { wu, wv }),
+            transmit: (!pure && ts > FTINY && transmitting)
                 .then_some(TransmissionLobe { beta: wu.max(wv) }),
-            delta: self.pure.then(|| self.bsdf.delta_coefficients(view_cosine)),
-            diffuse_reflect: reflecting
-                && (rd > FTINY || (self.kind.is_metal() && self.variant == Variant::Ward1992)),
+            delta: pure.then(|| self.bsdf.delta_coefficients(view_cosine)),
+            diffuse_reflect: reflecting && (rd > FTINY || ward_metal),
             diffuse_transmit: transmitting && t - ts > FTINY,
         }
     }
