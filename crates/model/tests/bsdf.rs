@@ -110,6 +110,40 @@ proptest! {
         }
     }
 
+    /// The diffuse part never exceeds the whole, and is the whole when the
+    /// material has no specular lobe: spec 0 (and tspec 0) on a rough
+    /// surface, except in
+    /// the Ward 1992 variant, whose Fresnel-like term gives a non-metal a
+    /// lobe even then.
+    #[test]
+    fn diffuse_part_is_part_of_the_whole(
+        kind in kinds(),
+        variant in variants(),
+        u in prop::array::uniform8(0.0f64..1.0),
+        theta_in in 0.0f64..89.0, phi_in in 0.0f64..360.0,
+        theta_out in 0.0f64..180.0, phi_out in 0.0f64..360.0,
+    ) {
+        let options = EvalOptions { variant, ..EvalOptions::default() };
+        let material = material_from(kind, &u);
+        let (l, v) = (direction(theta_in, phi_in), direction(theta_out, phi_out));
+        let bsdf = Bsdf::new(&material, &options);
+        let (whole, diffuse) = (bsdf.eval(l, v), bsdf.eval_diffuse(l, v));
+        for ch in 0..3 {
+            prop_assert!(diffuse[ch] >= 0.0 && diffuse[ch] <= whole[ch] * (1.0 + 1e-12));
+        }
+        if variant != Variant::Ward1992 {
+            // No reflected lobe (spec 0), no transmitted one (tspec 0).
+            let mut args = material.args().to_vec();
+            args[3] = 0.0;
+            if kind.is_transmitting() {
+                let last = args.len() - 1;
+                args[last] = 0.0;
+            }
+            let matte = Bsdf::new(&material.with_args(&args).unwrap(), &options);
+            prop_assert_eq!(matte.eval_diffuse(l, v), matte.eval(l, v));
+        }
+    }
+
     /// The reflection part of the radiance variant is reciprocal: f(l,v) = f(v,l).
     /// (Except where rtrace's Fresnel estimate is on, which is symmetric too.)
     #[test]
