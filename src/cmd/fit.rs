@@ -1,6 +1,7 @@
 //! `brtf fit FILE... --model M`: per-incidence fits, the all-incidence fit,
 //! the θ_in table, and the outputs in the fit folder.
 
+use super::material::{parse_fresnel_k, parse_variant};
 use super::output::write_atomic;
 use anyhow::{Context, Result, bail};
 use brtf_fit::{
@@ -8,7 +9,7 @@ use brtf_fit::{
     Interpolation, ParamTable, Provenance, ResidualKind, RobustLoss, fit_global, fit_incidence,
 };
 use brtf_gonio::{Hemisphere, Measurement, Quantity};
-use brtf_model::{FRESNEL_K_CLASSIC, FRESNEL_K_PYRADIANCE, MaterialKind, Variant};
+use brtf_model::{MaterialKind, Variant};
 use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
@@ -129,20 +130,6 @@ pub enum InterpArg {
 
 fn parse_kind(s: &str) -> Result<MaterialKind, String> {
     s.parse()
-}
-
-fn parse_variant(s: &str) -> Result<Variant, String> {
-    s.parse()
-}
-
-fn parse_fresnel_k(s: &str) -> Result<f64, String> {
-    match s {
-        "classic" => Ok(FRESNEL_K_CLASSIC),
-        "pyradiance" => Ok(FRESNEL_K_PYRADIANCE),
-        other => other
-            .parse()
-            .map_err(|_| format!("expected classic, pyradiance or a number, found `{other}`")),
-    }
 }
 
 fn parse_rho(s: &str) -> Result<(f64, f64), String> {

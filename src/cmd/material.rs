@@ -28,11 +28,13 @@ pub struct MaterialArgs {
     pub curved: bool,
 }
 
-fn parse_variant(s: &str) -> Result<Variant, String> {
+/// Clap parser for `--variant`.
+pub(crate) fn parse_variant(s: &str) -> Result<Variant, String> {
     s.parse()
 }
 
-fn parse_fresnel_k(s: &str) -> Result<f64, String> {
+/// Clap parser for `--fresnel-k`: `classic`, `pyradiance` or a number.
+pub(crate) fn parse_fresnel_k(s: &str) -> Result<f64, String> {
     match s {
         "classic" => Ok(FRESNEL_K_CLASSIC),
         "pyradiance" => Ok(FRESNEL_K_PYRADIANCE),

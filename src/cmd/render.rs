@@ -10,12 +10,12 @@
 //! The material comes from a Radiance file (`--material`) or a fit folder
 //! (`--fit DIR`: its θ_in-interpolated table, or `--static` for one set).
 
-use super::material::MaterialArgs;
+use super::material::{MaterialArgs, parse_fresnel_k, parse_variant};
 use super::output::write_atomic;
 use anyhow::{Context, Result, bail};
 use brtf_fit::FitResult;
 use brtf_gonio::{Channels, Measurement, SourceFormat};
-use brtf_model::{FRESNEL_K_CLASSIC, FRESNEL_K_PYRADIANCE, Material, Variant, cone_solid_angle};
+use brtf_model::{FRESNEL_K_CLASSIC, Material, Variant, cone_solid_angle};
 use brtf_trace::gonio::{GonioSetup, VirtualGonio, measurement_from};
 use brtf_trace::image::{ImageOptions, auto_exposure, write_png};
 use brtf_trace::{Camera, Scene, Settings, Shader, Shape, Source, hdr};
@@ -65,20 +65,6 @@ pub struct SampleMaterial {
     /// number [default: classic, or the fit's].
     #[arg(long, value_parser = parse_fresnel_k)]
     pub fresnel_k: Option<f64>,
-}
-
-fn parse_variant(s: &str) -> Result<Variant, String> {
-    s.parse()
-}
-
-fn parse_fresnel_k(s: &str) -> Result<f64, String> {
-    match s {
-        "classic" => Ok(FRESNEL_K_CLASSIC),
-        "pyradiance" => Ok(FRESNEL_K_PYRADIANCE),
-        other => other
-            .parse::<f64>()
-            .map_err(|_| format!("expected classic, pyradiance or a number, found `{other}`")),
-    }
 }
 
 /// A loaded material: the shader and a one-set material for exports.

@@ -363,6 +363,8 @@ fn fit_many(
         stats.push(scan.stats);
     }
     let n_points: usize = blocks.iter().map(Block::len).sum();
+    // Large enough to polish the best start on a subsample first.
+    let polish = n_points > 2 * POLISH_SAMPLES;
     // Three independent order statistics over every sample (the floor, the
     // starting values, the subsamples' brightness threshold), side by side.
     let n_blocks = blocks.len().max(1);
@@ -374,8 +376,9 @@ fn fit_many(
                 || prepare::starting_points(&stats, &map, config, channels),
             )
         },
+        // Subsamples are taken only by the multi-start and the polish.
         || -> Vec<f64> {
-            if config.multistart || n_points > 2 * POLISH_SAMPLES {
+            if config.multistart || polish {
                 blocks
                     .iter()
                     .map(|b| prepare::bright_threshold(b, share(BRIGHT_SAMPLES)))
@@ -390,10 +393,9 @@ fn fit_many(
     }
     let mut evaluations = 0;
     let solve = |blocks: &[Block], u0: DVector<f64>, stage: Stage| -> Solved {
-        let problem = Problem::new(&map, config, orientation, blocks, channels, floor);
-        let mut problem = problem;
+        let mut problem = Problem::new(&map, config, orientation, blocks, channels, floor);
         problem.u = u0.clone();
-        problem.with_meat = stage.meat;
+        problem.report = stage.report;
         let (problem, report) = LevenbergMarquardt::new()
             .with_ftol(stage.tolerance)
             .with_xtol(stage.tolerance)
@@ -449,7 +451,7 @@ fn fit_many(
         }
     }
     let mut u_start = best.map_or_else(|| starts[0].1.clone(), |(u, _)| u);
-    if n_points > 2 * POLISH_SAMPLES {
+    if polish {
         let polished = solve(&thin(POLISH_SAMPLES), u_start.clone(), Stage::START);
         evaluations += polished.evaluations;
         if polished.cost.is_finite() {
@@ -641,9 +643,9 @@ struct Stage {
     gtol: f64,
     /// Evaluation budget in units of (parameters + 1).
     patience: usize,
-    /// Accumulate the sandwich's middle term (only the final fit reports
-    /// standard errors).
-    meat: bool,
+    /// Its passes compute what the report uses (the sandwich's middle
+    /// term, `rms_rel`); only the final fit's solution is reported.
+    report: bool,
 }
 
 impl Stage {
@@ -656,7 +658,7 @@ impl Stage {
         tolerance: 1e-6,
         gtol: 1e-14,
         patience: 8,
-        meat: false,
+        report: false,
     };
     /// The fit on every sample. From the polished start it takes three
     /// steps; the gradient test stops it after the third, where ftol alone
@@ -665,7 +667,7 @@ impl Stage {
         tolerance: 1e-12,
         gtol: 1e-6,
         patience: 200,
-        meat: true,
+        report: true,
     };
 }
 

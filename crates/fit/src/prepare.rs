@@ -128,7 +128,7 @@ pub(crate) fn scan<'a>(
                     piece.positive.push(v);
                 }
             }
-            let mean = value.iter().sum::<f64>() / channels as f64;
+            let mean = channel_mean(s, channels);
             if s.view.z > 0.0 {
                 piece.front.push(mean);
                 for (sum, v) in piece.front_sums.iter_mut().zip(value) {
@@ -201,6 +201,11 @@ pub(crate) fn auto_floor(stats: &[ScanStats]) -> f64 {
     (0.1 * tenth).max(1e-12)
 }
 
+/// The mean of a sample's first `channels` values: its brightness.
+fn channel_mean(s: &FitSample, channels: usize) -> f64 {
+    s.value[..channels].iter().sum::<f64>() / channels as f64
+}
+
 /// The channel mean of the `count`-th brightest sample of `b` (minus
 /// infinity when it has no more samples than that).
 pub(crate) fn bright_threshold(b: &Block<'_>, count: usize) -> f64 {
@@ -208,10 +213,7 @@ pub(crate) fn bright_threshold(b: &Block<'_>, count: usize) -> f64 {
     if count == 0 || count >= b.len() {
         return f64::NEG_INFINITY;
     }
-    let means = b
-        .samples
-        .iter()
-        .map(|s| s.value[..channels].iter().sum::<f64>() / channels as f64);
+    let means = b.samples.iter().map(|s| channel_mean(s, channels));
     order_statistic(means, |len| len - count).unwrap_or(f64::NEG_INFINITY)
 }
 
@@ -228,7 +230,7 @@ pub(crate) fn subsample<'a>(b: &Block<'_>, target: usize, bright: f64) -> Block<
     let mut factors = Vec::new();
     let expand = (step as f64).sqrt();
     for (i, s) in b.samples.iter().enumerate() {
-        let mean = s.value[..channels].iter().sum::<f64>() / channels as f64;
+        let mean = channel_mean(s, channels);
         let m = if mean >= bright {
             1.0
         } else if i % step == 0 {

@@ -122,8 +122,10 @@ pub(crate) struct Problem<'a> {
     pub floor: f64,
     pub u: DVector<f64>,
     pub evaluations: Cell<usize>,
-    /// Also accumulate `Σ rᵢ² Jᵢ Jᵢᵀ` for the sandwich standard errors.
-    pub with_meat: bool,
+    /// A pass of the final fit, whose numbers the report uses: also
+    /// accumulate `Σ rᵢ² Jᵢ Jᵢᵀ` (the sandwich standard errors' middle)
+    /// and `rms_rel`, which the other stages do not need.
+    pub report: bool,
     /// Every compressed evaluation so far, by point: LM asks for the
     /// Jacobian of its last accepted point, and the fit's final report
     /// needs the triangle at the solution; neither needs a new pass.
@@ -150,7 +152,7 @@ impl<'a> Problem<'a> {
             floor,
             u: DVector::zeros(map.len()),
             evaluations: Cell::new(0),
-            with_meat: false,
+            report: false,
             history: RefCell::new(Vec::new()),
         }
     }
@@ -245,12 +247,12 @@ impl<'a> Problem<'a> {
             channels: self.channels,
             blocks: self.blocks,
         };
-        let with_meat = self.with_meat;
+        let report = self.report;
         let run_chunk = |chunk: &Chunk| -> ChunkResult {
             if !COMPRESS {
                 return kernel.residuals(*chunk);
             }
-            match (width, with_meat) {
+            match (width, report) {
                 (2, false) => kernel.gram::<2, false>(*chunk),
                 (2, true) => kernel.gram::<2, true>(*chunk),
                 (3, false) => kernel.gram::<3, false>(*chunk),
@@ -281,7 +283,12 @@ impl<'a> Problem<'a> {
         if !parts.iter().all(|p| p.finite) {
             return None;
         }
-        let rms_rel = (parts.iter().map(|p| p.sum_rel).sum::<f64>() / m.max(1) as f64).sqrt();
+        // Only report passes sum the relative errors (NaN marks the others).
+        let rms_rel = if COMPRESS && !self.report {
+            f64::NAN
+        } else {
+            (parts.iter().map(|p| p.sum_rel).sum::<f64>() / m.max(1) as f64).sqrt()
+        };
         if !COMPRESS {
             let mut residuals = Vec::with_capacity(m);
             for p in &parts {
@@ -300,7 +307,7 @@ impl<'a> Problem<'a> {
             }
         }
         let triangle = augmented_cholesky(&sums[..width * width], width);
-        let meat = self.with_meat.then(|| {
+        let meat = self.report.then(|| {
             // W × W layout, the first n × n used; upper triangle filled.
             let m = &sums[width * width..];
             DMatrix::from_fn(n, n, |a, b| m[a.min(b) * width + a.max(b)])
@@ -354,7 +361,7 @@ impl Kernel<'_> {
     /// The upper triangle of `[J | r]ᵀ[J | r]` of one chunk (row-major,
     /// `W × W`), for `W − 1` parameters; the fixed width lets the compiler
     /// unroll the accumulation.
-    fn gram<const W: usize, const MEAT: bool>(&self, (b, start, end): Chunk) -> ChunkResult {
+    fn gram<const W: usize, const REPORT: bool>(&self, (b, start, end): Chunk) -> ChunkResult {
         let block = &self.blocks[b];
         let channels = self.channels;
         let columns: &[(Target, f64)] = &self.columns[..W - 1];
@@ -375,7 +382,9 @@ impl Kernel<'_> {
             for ch in 0..channels {
                 let row = i * channels + ch;
                 let (res, dr_dm, rel2) = self.residual(f[ch], s.value[ch], block.factors[row]);
-                sum_rel += rel2;
+                if REPORT {
+                    sum_rel += rel2;
+                }
                 for (xj, &(target, dp_du)) in x.iter_mut().zip(columns) {
                     let dm_dp = match target {
                         Target::Arg(a) => self.scale * grad.d[a][ch],
@@ -392,7 +401,7 @@ impl Kernel<'_> {
                         gram[a][b] += x[a] * x[b];
                     }
                 }
-                if MEAT {
+                if REPORT {
                     let r2 = res * res;
                     for a in 0..W - 1 {
                         for b in a..W - 1 {
@@ -403,7 +412,7 @@ impl Kernel<'_> {
             }
         }
         let mut data: Vec<f64> = gram.iter().flatten().copied().collect();
-        if MEAT {
+        if REPORT {
             data.extend(meat.iter().flatten());
         }
         ChunkResult {
@@ -505,9 +514,10 @@ pub(crate) struct Compressed {
     pub residuals: DVector<f64>,
     /// `[R; 0]`, (n + 1) × n: `JᵀJ = RᵀR`.
     pub jacobian: DMatrix<f64>,
+    /// RMS relative error (NaN outside report passes).
     pub rms_rel: f64,
-    /// `Σ rᵢ² Jᵢ Jᵢᵀ` (n × n), the middle of the sandwich covariance, when
-    /// the problem was asked for it.
+    /// `Σ rᵢ² Jᵢ Jᵢᵀ` (n × n), the middle of the sandwich covariance, in a
+    /// report pass.
     pub meat: Option<DMatrix<f64>>,
 }
 
