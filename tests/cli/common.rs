@@ -175,10 +175,7 @@ pub fn direction(theta_deg: f64, phi_deg: f64) -> [f64; 3] {
     [st * cp, st * sp, ct]
 }
 
-/// Solid angle of a cone with full apex angle `apex_deg`: 2π(1 − cos(A/2)).
-pub fn cone_solid_angle(apex_deg: f64) -> f64 {
-    2.0 * std::f64::consts::PI * (1.0 - (apex_deg.to_radians() / 2.0).cos())
-}
+pub use brtf_model::cone_solid_angle;
 
 /// `|a − b| ≤ abs` or `≤ rel·|b|`.
 pub fn close(a: f64, b: f64, rel: f64, abs: f64) -> bool {

@@ -59,7 +59,7 @@ fn report(kind: MaterialKind, theta_in: f64, args: &[f64]) -> FitReport {
         scale: 1.0,
         n_points: 2000,
         gates: Vec::new(),
-        weighting: "grid".into(),
+        weighting: brtf_fit::Weighting::Caller,
         rms_rel: 0.012,
         cost: 0.5,
         floor: 0.0,
@@ -909,6 +909,6 @@ fn synthetic(material: &Material, theta_in: f64) -> IncidenceData {
         channels: 3,
         samples,
         gates: Vec::new(),
-        weighting: "grid".into(),
+        weighting: brtf_fit::Weighting::Caller,
     }
 }

@@ -443,21 +443,17 @@ fn parallel<T: Send>(n: usize, work: impl Fn(usize) -> T + Sync) -> Vec<T> {
 // Random materials
 // ---------------------------------------------------------------------------
 
-/// SplitMix64: a tiny, well-mixed, fixed-seed generator.
-struct SplitMix64(u64);
+/// brtf's seeded generator, with the ranges these tests draw from.
+struct Draws(brtf_model::Rng);
 
-impl SplitMix64 {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
+impl Draws {
+    fn new(seed: u64) -> Self {
+        Draws(brtf_model::Rng::from_state(seed))
     }
 
     /// Uniform in [0, 1).
     fn unit(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+        self.0.uniform()
     }
 
     fn range(&mut self, lo: f64, hi: f64) -> f64 {
@@ -490,7 +486,7 @@ struct RandomMaterial {
 }
 
 impl RandomMaterial {
-    fn draw(rng: &mut SplitMix64, kind: &'static str) -> Self {
+    fn draw(rng: &mut Draws, kind: &'static str) -> Self {
         let mut reals: Vec<f64> = (0..3).map(|_| round(rng.range(0.05, 1.0), 3)).collect();
         reals.push(if rng.chance(0.1) {
             0.0
@@ -580,7 +576,7 @@ fn angles(v: [f64; 3]) -> (f64, f64) {
 }
 
 /// A direction within `max_angle` radians of the unit vector `c`.
-fn around(rng: &mut SplitMix64, c: [f64; 3], max_angle: f64) -> [f64; 3] {
+fn around(rng: &mut Draws, c: [f64; 3], max_angle: f64) -> [f64; 3] {
     // Orthonormal frame (t1, t2) perpendicular to c.
     let a = if c[0].abs() < 0.9 {
         [1.0, 0.0, 0.0]
@@ -609,7 +605,7 @@ fn around(rng: &mut SplitMix64, c: [f64; 3], max_angle: f64) -> [f64; 3] {
 /// mirror (and, for trans types, the straight-through) direction. Never
 /// within 0.5° of grazing (θ_out = 90° returns NaN in rtrace).
 fn draw_directions(
-    rng: &mut SplitMix64,
+    rng: &mut Draws,
     m: &RandomMaterial,
     theta_in: f64,
     phi_in: f64,
@@ -675,7 +671,7 @@ fn random_materials_match_live_rtrace() {
     let omega = cone_solid_angle(SOURCE_APEX_DEG);
 
     // Draw everything up front, so the result does not depend on threads.
-    let mut rng = SplitMix64(seed);
+    let mut rng = Draws::new(seed);
     let sets: Vec<Vec<RandomMaterial>> = (0..SETS)
         .map(|s| {
             (0..SET_SIZE)

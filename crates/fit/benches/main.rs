@@ -55,7 +55,7 @@ pub fn bench_data() -> (Material, IncidenceData) {
         channels: 1,
         samples,
         gates: Vec::new(),
-        weighting: "ring solid angle".into(),
+        weighting: brtf_fit::Weighting::Caller,
     };
     (truth, data)
 }

@@ -1,6 +1,8 @@
 //! What the fitter consumes: per-incidence samples of a measured BSDF,
-//! already selected and converted by the caller (the fitter does no I/O).
+//! already selected and converted (by [`crate::Recipe`], or by a caller
+//! that builds them itself; the fitter does no I/O).
 
+use brtf_gonio::Gate;
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
@@ -17,13 +19,39 @@ pub struct FitSample {
     pub weight: f64,
 }
 
-/// A selection step the caller applied, for the report.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct GateReport {
-    /// What was applied, e.g. `theta_out <= 85`.
-    pub gate: String,
+/// A selection step that was applied, and how many samples it removed.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct GateCount {
+    /// The selection.
+    #[serde(flatten)]
+    pub gate: Gate,
     /// How many samples it removed.
     pub removed: usize,
+}
+
+/// Which weights the samples carry.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Weighting {
+    /// Solid angles: the file's Voronoi cells.
+    FileSolidAngles,
+    /// Solid angles computed from the sample directions.
+    ComputedSolidAngles,
+    /// Every sample weighs 1.
+    Uniform,
+    /// Weights set by the caller of the library.
+    Caller,
+}
+
+impl std::fmt::Display for Weighting {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Weighting::FileSolidAngles => "solid angle (the file's Voronoi cells)",
+            Weighting::ComputedSolidAngles => "solid angle (computed from the sample directions)",
+            Weighting::Uniform => "uniform",
+            Weighting::Caller => "set by the caller",
+        })
+    }
 }
 
 /// All samples of one incidence.
@@ -40,9 +68,9 @@ pub struct IncidenceData {
     /// The samples.
     pub samples: Vec<FitSample>,
     /// The selections applied before fitting.
-    pub gates: Vec<GateReport>,
-    /// Which weights the samples carry (e.g. `voronoi (file)`).
-    pub weighting: String,
+    pub gates: Vec<GateCount>,
+    /// Which weights the samples carry.
+    pub weighting: Weighting,
 }
 
 impl IncidenceData {

@@ -1,10 +1,18 @@
 //! # brtf-fit: Levenberg-Marquardt fits of Radiance materials
 //!
-//! Fits one of brtf-model's material types to the samples of each
-//! incidence ([`fit_incidence`]) or to all incidences at once
-//! ([`fit_global`]), and interpolates the per-incidence parameters in
-//! θ_in ([`ParamTable`]).
+//! From measurement files to one [`FitResult`]:
 //!
+//! ```text
+//! file ─brtf-gonio→ Measurement ─Recipe→ IncidenceData ─fit→ FitReport ─→ FitResult (fit.json)
+//! ```
+//!
+//! * [`Recipe`] says exactly how a measurement becomes the fitted quantity
+//!   (conversion, scale, colour, selections, weights);
+//!   [`Recipe::prepare`] is the one function that applies it, for the
+//!   fitter, the plots and the render check alike.
+//! * [`fit_incidence`] fits one incidence, [`fit_global`] all at once,
+//!   [`fit_set`] does the whole `brtf fit` (files → [`FitResult`]), and
+//!   [`ParamTable`] interpolates the per-incidence parameters in θ_in.
 //! * Parameters are fitted in unconstrained coordinates: a logistic maps
 //!   each to its physical box, `exp` keeps the free scale positive.
 //! * The Jacobian is exact, from brtf-model's analytic gradients.
@@ -16,18 +24,26 @@
 //!   width); a multi-start over roughness on a subsample that keeps every
 //!   bright sample (the lobe) escapes the local minima a single start
 //!   falls into.
-//! * Standard errors are `s² (JᵀJ)⁻¹`, with `s² = Σr²/(m − n)`, mapped to
-//!   physical units through the bound transform.
+//! * Standard errors are `s² (JᵀJ)⁻¹`, with `s² = Σr²/(m − n)`, and the
+//!   sandwich (HC1), mapped to physical units through the bound transform.
 //!
 //! This is the only crate that uses nalgebra and levenberg-marquardt.
 
+mod config;
 mod data;
 mod fitter;
 mod params;
 mod prepare;
 mod problem;
+mod recipe;
+mod report;
 mod result;
+mod robust;
+mod set;
+mod solve;
+mod summary;
 mod table;
+mod uncertainty;
 
 /// Serialises a material type as its Radiance name.
 pub(crate) mod serde_kind {
@@ -45,12 +61,18 @@ pub(crate) mod serde_kind {
     }
 }
 
-pub use data::{FitSample, GateReport, IncidenceData};
-pub use fitter::{
-    FitConfig, FitError, FitReport, ParamEstimate, RobustLoss, StartRecord, Termination,
-    fit_global, fit_incidence,
-};
+pub use brtf_gonio::Gate;
+pub use config::{FitConfig, FitError, RobustLoss};
+pub use data::{FitSample, GateCount, IncidenceData, Weighting};
+pub use fitter::{fit_global, fit_incidence};
 pub use params::{MAX_ROUGHNESS, MIN_ROUGHNESS, ParamMap, Slot, Target};
 pub use problem::ResidualKind;
-pub use result::{FitResult, InputFile, Provenance};
+pub use recipe::{
+    BeamOrigin, ColourConversion, Conversion, DataUnit, PreparedMeasurement, RawScale, Recipe,
+    RecipeError, ScaleRule, WeightRule,
+};
+pub use report::{FitReport, FitWarning, ParamEstimate, StartRecord, StderrRatio, Termination};
+pub use result::{FIT_JSON_SCHEMA, FitResult, InputFile, Provenance, ReadFitError, SetWarning};
+pub use set::{FitSetError, FitSetOptions, NoProgress, Progress, fit_set};
+pub use summary::summary;
 pub use table::{Interpolation, ParamTable, TableError, TableLookup};

@@ -4,7 +4,7 @@
 //! behind the automatic floor and the starting values.
 
 use crate::data::{FitSample, IncidenceData};
-use crate::fitter::{FitConfig, FitError};
+use crate::config::{FitConfig, FitError};
 use crate::params::{MIN_ROUGHNESS, ParamMap, Target};
 use crate::problem::Block;
 use glam::DVec3;

@@ -1,12 +1,21 @@
 //! The one result type that flows from the fitter to exports, plots and
-//! render checks: everything `brtf fit` learnt, with its provenance.
-//! Serialised as `fit.json`.
+//! render checks: everything `brtf fit` learnt, with its provenance and
+//! the [`Recipe`] that rebuilds its data. Serialised as `fit.json`, with a
+//! schema version that every reader checks ([`FitResult::read`]).
 
-use crate::fitter::{FitConfig, FitReport};
+use crate::config::FitConfig;
+use crate::recipe::{Conversion, Recipe};
+use crate::report::FitReport;
 use crate::table::{Interpolation, ParamTable};
 use brtf_model::{EvalOptions, Material};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// The `fit.json` schema this version writes and reads. Version 1 (no
+/// `schema` field) stored gates, weighting, warnings and the data
+/// quantity as English text.
+pub const FIT_JSON_SCHEMA: u32 = 2;
 
 /// One input measurement file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -19,8 +28,8 @@ pub struct InputFile {
     pub theta_in: f64,
     /// Incidence azimuth.
     pub phi_in: f64,
-    /// What the file holds (`BSDF`, `DSF`, `raw [uA]`...), and what the fit used.
-    pub quantity: String,
+    /// How the file's values became the fitted quantity.
+    pub conversion: Conversion,
     /// Samples in the file.
     pub samples: usize,
 }
@@ -38,17 +47,51 @@ pub struct Provenance {
     pub inputs: Vec<InputFile>,
 }
 
+/// Something the user should know about the whole set of fits.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "warning", rename_all = "snake_case")]
+pub enum SetWarning {
+    /// No θ_in table could be made.
+    NoTable {
+        /// Why (the table's error, for people).
+        reason: String,
+    },
+    /// `--rho` was given at an incidence far from every fitted one.
+    RhoFarFromIncidence {
+        /// The `--rho` incidence, degrees.
+        requested: f64,
+        /// The incidence used, degrees.
+        used: f64,
+    },
+}
+
+impl std::fmt::Display for SetWarning {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            SetWarning::NoTable { reason } => {
+                write!(f, "{reason}; no θ_in-dependent material is made")
+            }
+            SetWarning::RhoFarFromIncidence { requested, used } => write!(
+                f,
+                "--rho given at θ_in {requested}°, nearest fitted incidence is {used}°"
+            ),
+        }
+    }
+}
+
 /// Everything a fit produced.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FitResult {
-    /// Material name used in exports (the output folder's name by default).
+    /// The `fit.json` schema version ([`FIT_JSON_SCHEMA`]).
+    pub schema: u32,
+    /// Material name used in exports.
     pub name: String,
     /// Provenance.
     pub provenance: Provenance,
+    /// How every input file became the fitted data.
+    pub recipe: Recipe,
     /// The fit settings.
     pub config: FitConfig,
-    /// Selections applied to every file, as text (for the record).
-    pub selections: Vec<String>,
     /// One report per incidence, sorted by θ_in.
     pub incidences: Vec<FitReport>,
     /// One parameter set for all incidences.
@@ -57,9 +100,98 @@ pub struct FitResult {
     pub table: Option<ParamTable>,
     /// Interpolation method requested.
     pub interpolation: Interpolation,
+    /// Warnings about the whole set.
+    #[serde(default)]
+    pub warnings: Vec<SetWarning>,
+}
+
+/// Why `fit.json` could not be read.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ReadFitError {
+    /// The file could not be read.
+    #[error("cannot read {}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// The file is not JSON, or not a brtf fit of this schema.
+    #[error("{}: not a brtf fit result: {source}", path.display())]
+    Parse {
+        /// The file.
+        path: PathBuf,
+        /// What serde found.
+        source: serde_json::Error,
+    },
+    /// The schema version is not the one this brtf reads.
+    #[error(
+        "{}: fit.json schema version {found} is not supported (this brtf {} reads version {}); {}",
+        path.display(), env!("CARGO_PKG_VERSION"), FIT_JSON_SCHEMA,
+        if *found < u64::from(FIT_JSON_SCHEMA) { "refit with `brtf fit`" } else { "use a newer brtf" }
+    )]
+    Schema {
+        /// The file.
+        path: PathBuf,
+        /// The version found (1 when the field is missing).
+        found: u64,
+    },
 }
 
 impl FitResult {
+    /// Reads `fit.json`, or `DIR/fit.json` when `path` is a folder,
+    /// checking the schema version first.
+    pub fn read(path: &Path) -> Result<FitResult, ReadFitError> {
+        let path = if path.is_dir() {
+            path.join("fit.json")
+        } else {
+            path.to_path_buf()
+        };
+        let text = std::fs::read_to_string(&path).map_err(|source| ReadFitError::Io {
+            path: path.clone(),
+            source,
+        })?;
+        Self::from_json(&text, &path)
+    }
+
+    /// Parses the text of a `fit.json` read from `path` (for messages).
+    pub fn from_json(text: &str, path: &Path) -> Result<FitResult, ReadFitError> {
+        let parse = |source| ReadFitError::Parse {
+            path: path.to_path_buf(),
+            source,
+        };
+        let value: serde_json::Value = serde_json::from_str(text).map_err(parse)?;
+        // Version 1 had no `schema` field.
+        let found = match value.get("schema") {
+            None => 1,
+            Some(v) => v.as_u64().unwrap_or(0),
+        };
+        if found != u64::from(FIT_JSON_SCHEMA) {
+            return Err(ReadFitError::Schema {
+                path: path.to_path_buf(),
+                found,
+            });
+        }
+        serde_json::from_value(value).map_err(parse)
+    }
+
+    /// Writes `DIR/fit.json` and `DIR/params.csv`, each atomically.
+    pub fn write(&self, dir: &Path) -> Result<(), brtf_io::IoError> {
+        let csv = self.params_csv().map_err(|e| brtf_io::IoError {
+            path: dir.join("params.csv"),
+            what: "cannot format",
+            source: std::io::Error::other(e),
+        })?;
+        brtf_io::write_atomic(&dir.join("params.csv"), csv.as_bytes())?;
+        brtf_io::write_atomic(&dir.join("fit.json"), self.to_json().as_bytes())
+    }
+
+    /// The `fit.json` text.
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).expect("a FitResult always serialises")
+    }
+
     /// The evaluation options the fit used (variant, Fresnel constant, ω).
     pub fn options(&self) -> EvalOptions {
         self.config.options
@@ -81,5 +213,62 @@ impl FitResult {
             .as_ref()
             .or(self.incidences.first())
             .and_then(|r| self.material_of(r))
+    }
+
+    /// The input file of incidence `index`.
+    pub fn input_of(&self, index: usize) -> Option<&InputFile> {
+        let report = self.incidences.get(index)?;
+        self.provenance
+            .inputs
+            .iter()
+            .find(|i| i.path == report.source)
+            .or_else(|| self.provenance.inputs.get(index))
+    }
+
+    /// The material at θ_in: the table's, else the incidence's own fit
+    /// (`report`), else the static material.
+    pub fn material_at(&self, theta_in: f64, report: Option<&FitReport>) -> Option<Material> {
+        if let Some(table) = &self.table {
+            return table.at(theta_in).ok().map(|l| l.material);
+        }
+        report
+            .and_then(|r| self.material_of(r))
+            .or_else(|| self.static_material())
+    }
+
+    /// `params.csv`: one row per incidence, then the all-incidence fit as a
+    /// row with θ_in `all`.
+    pub fn params_csv(&self) -> Result<String, csv::Error> {
+        let Some(first) = self.incidences.first() else {
+            return Ok(String::new());
+        };
+        let names: Vec<&str> = first.params.iter().map(|p| p.name.as_str()).collect();
+        let mut w = csv::Writer::from_writer(Vec::new());
+        let mut header = vec!["theta_in".to_string(), "phi_in".into(), "n_points".into()];
+        header.extend(names.iter().map(|n| n.to_string()));
+        header.extend(names.iter().map(|n| format!("{n}_stderr")));
+        header.extend(["rms_rel".into(), "cost".into(), "termination".into()]);
+        w.write_record(&header)?;
+        let row = |r: &FitReport, theta: String, phi: String| -> Vec<String> {
+            let mut v = vec![theta, phi, r.n_points.to_string()];
+            v.extend(r.params.iter().map(|p| format!("{:.8}", p.value)));
+            v.extend(r.params.iter().map(|p| format!("{:.3e}", p.stderr)));
+            v.extend([
+                format!("{:.6}", r.rms_rel),
+                format!("{:.6e}", r.cost),
+                r.termination.label().into(),
+            ]);
+            v
+        };
+        for r in &self.incidences {
+            w.write_record(row(r, format!("{}", r.theta_in), format!("{}", r.phi_in)))?;
+        }
+        if let Some(g) = &self.global {
+            w.write_record(row(g, "all".into(), String::new()))?;
+        }
+        let bytes = w
+            .into_inner()
+            .map_err(|e| csv::Error::from(e.into_error()))?;
+        Ok(String::from_utf8(bytes).expect("CSV of UTF-8 text is UTF-8"))
     }
 }

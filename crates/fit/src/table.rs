@@ -2,7 +2,7 @@
 //! (PCHIP, Fritsch–Carlson) or linear interpolation, clamped outside the
 //! measured range.
 
-use crate::fitter::FitReport;
+use crate::report::FitReport;
 use brtf_model::{Material, MaterialKind, ModelError};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};

@@ -78,7 +78,7 @@ fn synth(material: &Material, theta_in: f64, phi_in: f64, noise: f64, seed: u64)
         channels: 3,
         samples,
         gates: Vec::new(),
-        weighting: "grid solid angle".into(),
+        weighting: brtf_fit::Weighting::Caller,
     }
 }
 
@@ -237,8 +237,8 @@ fn bad_input_gives_clear_errors() {
     let config = FitConfig::new(MaterialKind::Metal);
     let mut empty = synth(&m, 30.0, 0.0, 0.0, 1);
     empty.samples.clear();
-    empty.gates.push(brtf_fit::GateReport {
-        gate: "theta_out <= 85".into(),
+    empty.gates.push(brtf_fit::GateCount {
+        gate: brtf_fit::Gate::ThetaCap { max_deg: 85.0 },
         removed: 10,
     });
     let e = fit_incidence(&empty, &config).unwrap_err().to_string();
@@ -298,7 +298,7 @@ fn narrow_lobe_on_a_dense_uniform_grid_is_recovered() {
             channels: 1,
             samples,
             gates: Vec::new(),
-            weighting: "ring solid angle".into(),
+            weighting: brtf_fit::Weighting::Caller,
         };
         let report = fit_incidence(&data, &FitConfig::new(MaterialKind::Metal)).unwrap();
         let (spec, fitted_rough) = (

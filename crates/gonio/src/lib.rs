@@ -63,7 +63,7 @@ pub use read::{
     detect_format, incidence_from_file_name, read_bytes, read_bytes_as, read_path, read_path_as,
     read_str,
 };
-pub use select::{DEFAULT_THETA_CAP_DEG, Selection};
+pub use select::{DEFAULT_THETA_CAP_DEG, Gate, GateContext, Selection};
 pub use solid_angle::{SolidAngleSource, SolidAngles, compute_solid_angles, solid_angles};
 pub use summary::{HemisphereSummary, Peak, Summary};
 pub use write::{to_mountain_string, to_mpc_string, write_mountain, write_mpc, write_path};

@@ -1,18 +1,123 @@
 //! Sample selections a fitter applies before fitting.
 //!
-//! This module owns the filters: hemisphere, a grazing-angle θ cap, a cone
-//! around the incident beam where the detector cannot see, and value floors
-//! (below a value, not available, non-finite). Each returns a
-//! [`Selection`]: the new measurement, the indices kept (into the input),
-//! and how many samples were removed. Samples keep their solid angles; call
-//! [`Measurement::fill_solid_angles`] first if the weights should describe
-//! the full layout rather than be recomputed after the selection.
+//! This module owns the filters as one typed [`Gate`]: hemisphere, a
+//! grazing-angle θ cap, a cone around the incident beam where the detector
+//! cannot see, and value floors (below a value, not available,
+//! non-finite). A gate is data (serialised into `fit.json`), and
+//! [`Gate::keeps`] is the one place that decides whether a sample passes
+//! it, for the fitter, the plots and the check alike.
+//!
+//! The `Measurement` methods return a [`Selection`]: the new measurement,
+//! the indices kept (into the input), and how many samples were removed.
+//! Samples keep their solid angles; call [`Measurement::fill_solid_angles`]
+//! first if the weights should describe the full layout rather than be
+//! recomputed after the selection.
 
 use crate::measurement::{Hemisphere, Measurement, Sample};
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
 
 /// The default θ cap: samples farther than this from the nearer normal
 /// (front or back) are grazing and usually unreliable.
 pub const DEFAULT_THETA_CAP_DEG: f64 = 85.0;
+
+/// One selection step. Its `Display` is for people only: nothing parses it.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "gate", rename_all = "snake_case")]
+pub enum Gate {
+    /// Drops values that are not available (9.9e+37) or not finite.
+    Unavailable,
+    /// Keeps one hemisphere (front: θ ≤ 90°, back: θ > 90°).
+    Hemisphere {
+        /// The hemisphere kept.
+        keep: Hemisphere,
+    },
+    /// Keeps samples within `max_deg` of the nearer normal.
+    ThetaCap {
+        /// Largest θ_out from the nearer normal, degrees.
+        max_deg: f64,
+    },
+    /// Drops samples within `half_angle_deg` of the incident direction.
+    BeamMask {
+        /// Half-angle of the masked cone, degrees.
+        half_angle_deg: f64,
+    },
+    /// Drops samples with a used value below `min` (or not finite).
+    MinValue {
+        /// The smallest value kept, in the data's unit.
+        min: f64,
+    },
+}
+
+/// What a gate needs to know about the measurement it filters.
+#[derive(Clone, Copy, Debug)]
+pub struct GateContext {
+    /// Values per sample that are used (1 or 3).
+    channels: usize,
+    /// Towards the light.
+    light: DVec3,
+}
+
+impl GateContext {
+    /// The context of `measurement`.
+    pub fn of(measurement: &Measurement) -> GateContext {
+        GateContext {
+            channels: measurement.channels.count(),
+            light: measurement.incident_direction(),
+        }
+    }
+}
+
+impl Gate {
+    /// True when `sample` passes the gate.
+    pub fn keeps(&self, sample: &Sample, context: &GateContext) -> bool {
+        let values = &sample.values[..context.channels];
+        match *self {
+            Gate::Unavailable => values.iter().all(|v| v.is_finite()),
+            Gate::Hemisphere { keep } => sample.hemisphere() == keep,
+            Gate::ThetaCap { max_deg } => {
+                sample.theta_deg.min(180.0 - sample.theta_deg) <= max_deg
+            }
+            Gate::BeamMask { half_angle_deg } => {
+                sample.direction().dot(context.light) < half_angle_deg.to_radians().cos()
+            }
+            Gate::MinValue { min } => values.iter().all(|&v| v.is_finite() && v >= min),
+        }
+    }
+
+    /// A short label for legends: what the gate removed.
+    pub fn removed_label(&self) -> String {
+        match self {
+            Gate::Unavailable => "not available".into(),
+            Gate::Hemisphere {
+                keep: Hemisphere::Front,
+            } => "back hemisphere".into(),
+            Gate::Hemisphere {
+                keep: Hemisphere::Back,
+            } => "front hemisphere".into(),
+            Gate::ThetaCap { max_deg } => format!("θ_out > {max_deg}°"),
+            Gate::BeamMask { half_angle_deg } => format!("{half_angle_deg}° beam mask"),
+            Gate::MinValue { min } => format!("value < {min}"),
+        }
+    }
+}
+
+impl std::fmt::Display for Gate {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Gate::Unavailable => f.write_str("not available or not finite"),
+            Gate::Hemisphere {
+                keep: Hemisphere::Front,
+            } => f.write_str("front hemisphere only"),
+            Gate::Hemisphere {
+                keep: Hemisphere::Back,
+            } => f.write_str("back hemisphere only"),
+            Gate::ThetaCap { max_deg } => write!(f, "theta_out <= {max_deg}°"),
+            Gate::BeamMask { half_angle_deg } => write!(f, "{half_angle_deg}° beam mask"),
+            Gate::MinValue { min } => write!(f, "value >= {min}"),
+        }
+    }
+}
 
 /// The result of a selection.
 #[derive(Clone, Debug, PartialEq)]
@@ -42,35 +147,39 @@ impl Measurement {
         }
     }
 
+    /// Keeps the samples that pass `gate`.
+    pub fn apply_gate(&self, gate: Gate) -> Selection {
+        let context = GateContext::of(self);
+        self.select(|s| gate.keeps(s, &context))
+    }
+
     /// Keeps one hemisphere (front: θ ≤ 90°, back: θ > 90°).
     pub fn select_hemisphere(&self, hemisphere: Hemisphere) -> Selection {
-        self.select(|s| s.hemisphere() == hemisphere)
+        self.apply_gate(Gate::Hemisphere { keep: hemisphere })
     }
 
     /// Keeps samples within `max_theta_deg` of the nearer normal: θ ≤ cap in
     /// front, 180° − θ ≤ cap in back. See [`DEFAULT_THETA_CAP_DEG`].
     pub fn cap_theta(&self, max_theta_deg: f64) -> Selection {
-        self.select(|s| s.theta_deg.min(180.0 - s.theta_deg) <= max_theta_deg)
+        self.apply_gate(Gate::ThetaCap {
+            max_deg: max_theta_deg,
+        })
     }
 
     /// Removes samples within `half_angle_deg` of the incident direction
     /// (θ_in, φ_in), where the detector would block the beam.
     pub fn mask_incident_cone(&self, half_angle_deg: f64) -> Selection {
-        let towards_light = self.incident_direction();
-        let cos_limit = half_angle_deg.to_radians().cos();
-        self.select(|s| s.direction().dot(towards_light) < cos_limit)
+        self.apply_gate(Gate::BeamMask { half_angle_deg })
     }
 
     /// Removes samples with a used value below `floor`, not available or
     /// not finite (for CIE-XYZ: if any of X, Y, Z is).
     pub fn drop_below(&self, floor: f64) -> Selection {
-        let n = self.channels.count();
-        self.select(|s| s.values[..n].iter().all(|&v| v.is_finite() && v >= floor))
+        self.apply_gate(Gate::MinValue { min: floor })
     }
 
     /// Removes samples with a value that is not available or not finite.
     pub fn drop_unavailable(&self) -> Selection {
-        let channels = self.channels;
-        self.select(|s| s.is_available(channels))
+        self.apply_gate(Gate::Unavailable)
     }
 }

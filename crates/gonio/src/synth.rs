@@ -14,7 +14,7 @@ use crate::measurement::{
     Channels, Incidence, IncidenceOrigin, Measurement, Quantity, Sample, SourceFormat,
 };
 use crate::solid_angle::compute_solid_angles;
-use brtf_model::{Bsdf, direction};
+use brtf_model::{Bsdf, Rng, direction};
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -170,28 +170,6 @@ pub struct SynthSpec {
     pub sample_name: String,
 }
 
-/// SplitMix64: a tiny, well-mixed seeded generator.
-struct Rng(u64);
-
-impl Rng {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    fn uniform(&mut self) -> f64 {
-        ((self.next_u64() >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    }
-
-    fn normal(&mut self) -> f64 {
-        let (a, b) = (self.uniform(), self.uniform());
-        (-2.0 * a.ln()).sqrt() * (2.0 * PI * b).cos()
-    }
-}
-
 /// Unit vectors perpendicular to `d`.
 fn frame(d: DVec3) -> (DVec3, DVec3) {
     let helper = if d.z.abs() < 0.9 { DVec3::Z } else { DVec3::X };
@@ -292,7 +270,7 @@ impl Incidence {
 
 /// A synthetic measurement of `spec` (BSDF, with file-style solid angles).
 pub fn synthesize(spec: &SynthSpec) -> Measurement {
-    let mut rng = Rng(spec.seed ^ 0xB5F0_2A11_u64);
+    let mut rng = Rng::from_state(spec.seed ^ 0xB5F0_2A11_u64);
     let instrument = &spec.instrument;
     let light = spec.incidence.direction();
     let lights = cone_directions(

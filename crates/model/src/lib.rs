@@ -29,12 +29,14 @@ mod bsdf;
 mod kind;
 mod material;
 mod options;
+pub mod rng;
 
 pub use albedo::{Albedo, albedo, gauss_legendre_rule};
 pub use bsdf::{Bsdf, Geometry, Gradient, Rgb, ViewSplit};
 pub use kind::{MaterialKind, Variant};
 pub use material::{FTINY, MAX_ARGS, Material, ModelError};
 pub use options::{EvalOptions, FRESNEL_K_CLASSIC, FRESNEL_K_PYRADIANCE};
+pub use rng::Rng;
 
 use glam::DVec3;
 

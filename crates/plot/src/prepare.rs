@@ -1,18 +1,12 @@
 //! Re-reading the measurements of a fit and putting the fitted model next to
 //! them, sample by sample, exactly as `brtf fit` compared them.
 //!
-//! This module owns the "recipe" that turns a measurement file into the
-//! data the fitter saw, rebuilt from `fit.json`:
-//!
-//! * **Conversion** (from [`InputFile::quantity`]): BSDF files are used as
-//!   they are, DSF files are divided by |cos θ_out|, raw-signal files by
-//!   |cos θ_out| and by the beam integral or the `--rho` scale K when the
-//!   fit had one. Without either the data stay in the file's unit and the
-//!   model is `scale × f` with the fitted free scale ([`FitReport::scale`],
-//!   1 when there is none).
-//! * **Selections**, in the order of the report's [`FitReport::gates`]:
-//!   not available, hemisphere, θ cap, beam mask, value floor. Every sample
-//!   remembers whether it was fitted and, if not, which gate removed it.
+//! The data are rebuilt by the fit's own [`brtf_fit::Recipe`] (stored in
+//! `fit.json`), through [`brtf_fit::Recipe::prepare`], the function the
+//! fitter's data came from: the same conversion (BSDF, DSF ÷ |cos θ_out|,
+//! raw signal ÷ beam integral or the `--rho` scale K, or in the file's unit
+//! with the fitted free scale on the model) and the same selections, each
+//! sample remembering which gate removed it.
 //!
 //! The rebuild is checked: the number of fitted samples must equal
 //! [`FitReport::n_points`] and the RMS relative error recomputed here must
@@ -23,105 +17,13 @@
 //! of the three channels.
 
 use crate::disk::{self, Coverage};
-use brtf_fit::{FitReport, FitResult, InputFile};
-use brtf_gonio::{Hemisphere, Measurement, Quantity};
+pub use brtf_fit::{DataUnit, Gate};
+use brtf_fit::{FitReport, FitResult};
+use brtf_gonio::Hemisphere;
 use brtf_model::Bsdf;
 use glam::DVec3;
-use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
-
-/// One selection step of the fit, parsed from its [`brtf_fit::GateReport`].
-#[derive(Debug, Clone, PartialEq)]
-pub enum Gate {
-    /// Values not available (9.9e+37) or not finite.
-    Unavailable,
-    /// Only one hemisphere.
-    Hemisphere(Hemisphere),
-    /// θ_out ≤ cap (degrees from the nearer normal).
-    ThetaCap(f64),
-    /// A cone of this half-angle (degrees) around the incident beam.
-    BeamMask(f64),
-    /// Values below this floor.
-    MinValue(f64),
-    /// A gate this version does not know; it is not reproduced.
-    Unknown(String),
-}
-
-impl Gate {
-    /// Parses the text `brtf fit` writes into `gates[].gate`.
-    pub fn parse(text: &str) -> Gate {
-        let t = text.trim();
-        let number = |s: &str| s.trim().trim_end_matches('°').trim().parse::<f64>().ok();
-        if t == "not available or not finite" {
-            Gate::Unavailable
-        } else if t == "front hemisphere only" {
-            Gate::Hemisphere(Hemisphere::Front)
-        } else if t == "back hemisphere only" {
-            Gate::Hemisphere(Hemisphere::Back)
-        } else if let Some(cap) = t.strip_prefix("theta_out <=").and_then(number) {
-            Gate::ThetaCap(cap)
-        } else if let Some(mask) = t.strip_suffix("beam mask").and_then(number) {
-            Gate::BeamMask(mask)
-        } else if let Some(v) = t.strip_prefix("value >=").and_then(number) {
-            Gate::MinValue(v)
-        } else {
-            Gate::Unknown(t.to_string())
-        }
-    }
-
-    /// A short label for legends.
-    pub fn label(&self) -> String {
-        match self {
-            Gate::Unavailable => "not available".into(),
-            Gate::Hemisphere(Hemisphere::Front) => "back hemisphere".into(),
-            Gate::Hemisphere(Hemisphere::Back) => "front hemisphere".into(),
-            Gate::ThetaCap(c) => format!("θ_out > {c}°"),
-            Gate::BeamMask(m) => format!("{m}° beam mask"),
-            Gate::MinValue(v) => format!("value < {v}"),
-            Gate::Unknown(t) => t.clone(),
-        }
-    }
-
-    fn apply(&self, m: &Measurement) -> Option<brtf_gonio::Selection> {
-        match self {
-            Gate::Unavailable => Some(m.drop_unavailable()),
-            Gate::Hemisphere(h) => Some(m.select_hemisphere(*h)),
-            Gate::ThetaCap(c) => Some(m.cap_theta(*c)),
-            Gate::BeamMask(h) => Some(m.mask_incident_cone(*h)),
-            Gate::MinValue(v) => Some(m.drop_below(*v)),
-            Gate::Unknown(_) => None,
-        }
-    }
-}
-
-/// What the plotted data values are.
-#[derive(Debug, Clone, PartialEq)]
-pub enum DataUnit {
-    /// BSDF in 1/sr (from BSDF, DSF or raw data with a beam integral).
-    Bsdf,
-    /// Raw signal ÷ |cos θ_out| in the file's unit (no beam integral; the
-    /// model carries the free scale).
-    RawPerCos(String),
-}
-
-impl DataUnit {
-    /// Axis title for values of this unit.
-    pub fn axis(&self) -> String {
-        match self {
-            DataUnit::Bsdf => "BSDF [1/sr]".into(),
-            DataUnit::RawPerCos(u) => format!("raw signal ÷ |cos θ_out| [{u}]"),
-        }
-    }
-
-    /// Axis title for a hemispherical integral Σ value·|cos θ|·ΔΩ.
-    pub fn integral_axis(&self) -> String {
-        match self {
-            DataUnit::Bsdf => "ρ_dh (directional-hemispherical reflectance) [–]".into(),
-            DataUnit::RawPerCos(u) => format!("Σ raw signal · ΔΩ [{u}·sr] (no beam integral)"),
-        }
-    }
-}
 
 /// One sample of the file, with the model next to it.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -222,7 +124,7 @@ impl Incidence {
     /// The θ cap, if one was applied.
     pub fn theta_cap(&self) -> Option<f64> {
         self.gates.iter().find_map(|g| match g {
-            Gate::ThetaCap(c) => Some(*c),
+            Gate::ThetaCap { max_deg } => Some(*max_deg),
             _ => None,
         })
     }
@@ -230,7 +132,7 @@ impl Incidence {
     /// The beam-mask half-angle, if one was applied.
     pub fn beam_mask(&self) -> Option<f64> {
         self.gates.iter().find_map(|g| match g {
-            Gate::BeamMask(m) if *m > 0.0 => Some(*m),
+            Gate::BeamMask { half_angle_deg } if *half_angle_deg > 0.0 => Some(*half_angle_deg),
             _ => None,
         })
     }
@@ -258,67 +160,8 @@ impl Incidence {
     }
 }
 
-/// Finds a measurement file: as given (relative to the current folder),
-/// then relative to every extra folder, the fit folder and its ancestors.
-pub fn locate(path: &str, fit_dir: &Path, search: &[PathBuf]) -> Option<PathBuf> {
-    let given = Path::new(path);
-    if given.is_file() {
-        return Some(given.to_path_buf());
-    }
-    if given.is_absolute() {
-        return None;
-    }
-    let mut bases: Vec<PathBuf> = search.to_vec();
-    if let Ok(dir) = std::fs::canonicalize(fit_dir) {
-        bases.extend(dir.ancestors().map(Path::to_path_buf));
-    }
-    bases
-        .into_iter()
-        .map(|b| b.join(given))
-        .find(|p| p.is_file())
-}
-
-/// Hex SHA-256 of `bytes`.
-fn sha256_hex(bytes: &[u8]) -> String {
-    Sha256::digest(bytes)
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect()
-}
-
-/// The number following `marker` in the quantity text, if any.
-fn number_after(quantity: &str, marker: &str) -> Option<f64> {
-    let rest = quantity.split(marker).nth(1)?;
-    rest.split_whitespace().next()?.parse().ok()
-}
-
-/// What the fit divided raw signal by (besides |cos θ_out|), from the
-/// quantity text: the beam integral (`raw [uA] ÷ beam integral 123 ÷ |cos
-/// θ_out|`) or the instrument scale of `--rho` (`raw [uA] ÷ |cos θ_out| ÷ K
-/// = 3.2e-2 from --rho 0.8@30`).
-fn raw_divisor(quantity: &str) -> Option<f64> {
-    number_after(quantity, "beam integral")
-        .or_else(|| number_after(quantity, "÷ K ="))
-        .filter(|v| v.is_finite() && *v > 0.0)
-}
-
-/// Converts the file's values to what the fitter compared (see the module
-/// docs), with the unit they end up in.
-fn convert(m: &Measurement, input: &InputFile) -> Result<(Measurement, DataUnit), String> {
-    let converted = match &m.quantity {
-        Quantity::Bsdf => return Ok((m.clone(), DataUnit::Bsdf)),
-        Quantity::Dsf => m.to_bsdf().map(|c| (c.measurement, DataUnit::Bsdf)),
-        Quantity::Raw { unit, .. } => match raw_divisor(&input.quantity) {
-            Some(beam) => m.raw_to_bsdf(beam).map(|c| (c.measurement, DataUnit::Bsdf)),
-            None => m
-                .raw_to_bsdf(1.0)
-                .map(|c| (c.measurement, DataUnit::RawPerCos(unit.clone()))),
-        },
-    };
-    converted.map_err(|e| e.to_string())
-}
-
-/// Reads the file of `report` and builds the incidence, or says why not.
+/// Reads the file of `report`, applies the fit's recipe and builds the
+/// incidence, or says why not.
 pub fn load(
     result: &FitResult,
     index: usize,
@@ -328,13 +171,9 @@ pub fn load(
 ) -> Result<Incidence, String> {
     let report = &result.incidences[index];
     let input = result
-        .provenance
-        .inputs
-        .iter()
-        .find(|i| i.path == report.source)
-        .or_else(|| result.provenance.inputs.get(index))
+        .input_of(index)
         .ok_or_else(|| format!("{}: not listed in the provenance", report.source))?;
-    let path = locate(&input.path, fit_dir, search).ok_or_else(|| {
+    let path = brtf_io::locate_input(&input.path, fit_dir, search).ok_or_else(|| {
         format!(
             "{}: measurement file not found (looked relative to the current folder and {}); \
              its map and cut are not drawn",
@@ -345,47 +184,27 @@ pub fn load(
     let bytes =
         std::fs::read(&path).map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
     let mut warnings = Vec::new();
-    if !input.sha256.is_empty() && sha256_hex(&bytes) != input.sha256 {
+    if !input.sha256.is_empty() && brtf_io::sha256_hex(&bytes) != input.sha256 {
         warnings.push(format!(
             "{}: the file changed since the fit (SHA-256 differs); the plots show the new contents",
             input.path
         ));
     }
     let m = brtf_gonio::read_bytes(&bytes, &path).map_err(|e| e.to_string())?;
-    let channels = m.channels.count().clamp(1, 3);
-    let (m, unit) = convert(&m, input)?;
+    let prepared = result
+        .recipe
+        .prepare(m, &input.path)
+        .map_err(|e| e.to_string())?;
+    let channels = prepared.channels();
+    let unit = prepared.conversion.unit();
     let material = result
         .material_of(report)
         .ok_or_else(|| format!("{}: the fitted arguments are not a material", input.path))?;
     let bsdf = Bsdf::new(&material, &result.options());
     let light = brtf_model::direction(report.theta_in, report.phi_in);
-
-    // Apply the gates in order, remembering which removed what.
-    let gates: Vec<Gate> = report.gates.iter().map(|g| Gate::parse(&g.gate)).collect();
-    let mut removed_by: Vec<Option<usize>> = vec![None; m.len()];
-    let mut alive: Vec<usize> = (0..m.len()).collect();
-    let mut current = m.clone();
-    for (g, gate) in gates.iter().enumerate() {
-        let Some(sel) = gate.apply(&current) else {
-            warnings.push(format!(
-                "{}: selection `{}` is not known to brtf-plot and was not reproduced",
-                input.path,
-                gate.label()
-            ));
-            continue;
-        };
-        let mut keep = vec![false; alive.len()];
-        for &k in &sel.kept {
-            keep[k] = true;
-        }
-        for (k, &orig) in alive.iter().enumerate() {
-            if !keep[k] {
-                removed_by[orig] = Some(g);
-            }
-        }
-        alive = sel.kept.iter().map(|&k| alive[k]).collect();
-        current = sel.measurement;
-    }
+    let gates: Vec<Gate> = result.recipe.selections.clone();
+    let removed_by = &prepared.removed_by;
+    let m = &prepared.measurement;
 
     let floor = report.floor;
     let floor2 = floor * floor;
@@ -394,7 +213,7 @@ pub fn load(
     let samples: Vec<PlotSample> = m
         .samples
         .iter()
-        .zip(&removed_by)
+        .zip(removed_by)
         .map(|(s, removed)| {
             let dir = s.direction();
             let f = bsdf.eval(light, dir);
@@ -430,7 +249,7 @@ pub fn load(
         ));
     } else {
         let rms = (sum_rel / (n_used * channels).max(1) as f64).sqrt();
-        // Loose enough for numbers rounded in the quantity text.
+        // Loose enough for the fitter's other summation order.
         let tolerance = 1e-5 * report.rms_rel.abs().max(1e-9);
         if (rms - report.rms_rel).abs() > tolerance.max(1e-9) {
             warnings.push(format!(
@@ -490,39 +309,6 @@ pub fn num(x: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn gates_parse_as_brtf_fit_writes_them() {
-        assert_eq!(
-            Gate::parse("not available or not finite"),
-            Gate::Unavailable
-        );
-        assert_eq!(
-            Gate::parse("front hemisphere only"),
-            Gate::Hemisphere(Hemisphere::Front)
-        );
-        assert_eq!(Gate::parse("theta_out <= 85°"), Gate::ThetaCap(85.0));
-        assert_eq!(Gate::parse("3° beam mask"), Gate::BeamMask(3.0));
-        assert_eq!(Gate::parse("2.5° beam mask"), Gate::BeamMask(2.5));
-        assert_eq!(Gate::parse("value >= 0.001"), Gate::MinValue(0.001));
-        assert!(matches!(Gate::parse("something new"), Gate::Unknown(_)));
-    }
-
-    #[test]
-    fn the_raw_divisor_is_read_from_the_quantity_text() {
-        assert_eq!(
-            raw_divisor("raw [uA] ÷ beam integral 6.3 ÷ |cos θ_out|"),
-            Some(6.3)
-        );
-        assert_eq!(
-            raw_divisor("raw [uA] ÷ |cos θ_out|, free scale (no beam integral)"),
-            None
-        );
-        assert_eq!(
-            raw_divisor("raw [uA] ÷ |cos θ_out| ÷ K = 3.210000e-2 from --rho 0.8@30"),
-            Some(0.0321)
-        );
-    }
 
     #[test]
     fn numbers_for_names_are_short() {

@@ -5,7 +5,7 @@
 //! to the fit folder (`plots/<name>.svg`, with the PNG one click away).
 
 use crate::charts::{fmt, incidence_label};
-use crate::prepare::{Gate, Incidence, num};
+use crate::prepare::{Incidence, num};
 use brtf_fit::{FitReport, FitResult};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -254,7 +254,7 @@ fn provenance_section(out: &mut String, dir: &Path, result: &FitResult) {
             num(i.theta_in),
             num(i.phi_in),
             i.samples,
-            esc(&i.quantity),
+            esc(&i.conversion.to_string()),
             esc(&i.sha256)
         );
     }
@@ -283,7 +283,13 @@ fn provenance_section(out: &mut String, dir: &Path, result: &FitResult) {
         c.loss,
         c.multistart,
         result.interpolation,
-        esc(&result.selections.join("; "))
+        esc(&result
+            .recipe
+            .selections
+            .iter()
+            .map(|g| g.to_string())
+            .collect::<Vec<_>>()
+            .join("; "))
     );
     let mut links = Vec::new();
     for f in ["fit.json", "params.csv"] {
@@ -383,7 +389,7 @@ pub fn html(input: &ReportInput) -> String {
             let gates: Vec<String> = r
                 .gates
                 .iter()
-                .map(|g| format!("{} (−{})", esc(&g.gate), g.removed))
+                .map(|g| format!("{} (−{})", esc(&g.gate.to_string()), g.removed))
                 .collect();
             let _ = write!(out, "; selections: {}", gates.join(", "));
         }
@@ -395,11 +401,6 @@ pub fn html(input: &ReportInput) -> String {
             Ok(inc) => {
                 for w in &inc.warnings {
                     let _ = writeln!(out, "<p class=\"warn\">{}</p>", esc(w));
-                }
-                if inc.gates.iter().any(|g| matches!(g, Gate::Unknown(_))) {
-                    out.push_str(
-                        "<p class=\"muted\">Some selections could not be reproduced.</p>\n",
-                    );
                 }
                 out.push_str("<div class=\"pair\">\n");
                 for (stem, size, what) in &entry.charts {

@@ -33,7 +33,7 @@ fn report(kind: MaterialKind, theta_in: f64, args: &[f64]) -> FitReport {
         scale: 1.0,
         n_points: 8000,
         gates: Vec::new(),
-        weighting: "voronoi".into(),
+        weighting: brtf_fit::Weighting::Caller,
         rms_rel: 0.0421,
         cost: 7.5,
         floor: 0.01,

@@ -46,9 +46,10 @@ pub fn one_minus_cos(a: f64) -> f64 {
     2.0 * s * s
 }
 
-/// Solid angle of a cone of half-angle `a` (radians): `2π(1 − cos a)`.
+/// Solid angle of the spherical cap of half-angle `a` (radians): `2π(1 − cos a)`
+/// (not [`brtf_model::cone_solid_angle`], which takes a full apex angle in degrees).
 #[inline]
-pub fn cone_solid_angle(half_angle: f64) -> f64 {
+pub fn cap_solid_angle(half_angle: f64) -> f64 {
     2.0 * PI * one_minus_cos(half_angle)
 }
 
@@ -84,7 +85,7 @@ pub fn uniform_cone(axis: DVec3, half_angle: f64, u: [f64; 2]) -> DVec3 {
 #[inline]
 pub fn uniform_cone_pdf(axis: DVec3, half_angle: f64, d: DVec3) -> f64 {
     if 1.0 - axis.dot(d) <= one_minus_cos(half_angle) {
-        1.0 / cone_solid_angle(half_angle)
+        1.0 / cap_solid_angle(half_angle)
     } else {
         0.0
     }
@@ -197,7 +198,7 @@ mod tests {
     #[test]
     fn cone_helpers_agree() {
         for a in [1e-5, 0.01, 0.3, 1.5] {
-            let w = cone_solid_angle(a);
+            let w = cap_solid_angle(a);
             assert!((cone_half_angle(w) - a).abs() < 1e-9 * a.max(1.0));
         }
     }

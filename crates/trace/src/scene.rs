@@ -13,7 +13,7 @@
 use brtf_model::Rgb;
 use glam::DVec3;
 
-use crate::sampling::{cone_solid_angle, one_minus_cos, uniform_cone};
+use crate::sampling::{cap_solid_angle, one_minus_cos, uniform_cone};
 use crate::shader::Shader;
 
 /// A ray: origin and unit direction.
@@ -187,7 +187,7 @@ impl Source {
             } => Some(SourceSample {
                 dir: uniform_cone(dir, half_angle, u),
                 distance: f64::INFINITY,
-                omega: cone_solid_angle(half_angle),
+                omega: cap_solid_angle(half_angle),
                 radiance,
             }),
             Source::Sphere {
@@ -211,7 +211,7 @@ impl Source {
                 Some(SourceSample {
                     dir,
                     distance,
-                    omega: cone_solid_angle(half_angle),
+                    omega: cap_solid_angle(half_angle),
                     radiance,
                 })
             }

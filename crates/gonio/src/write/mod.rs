@@ -17,7 +17,6 @@ pub(crate) mod mountain;
 pub(crate) mod mpc;
 
 use std::fmt::Write as _;
-use std::io::Write as _;
 use std::path::Path;
 
 use crate::error::WriteError;
@@ -85,33 +84,12 @@ pub(crate) fn push_number(out: &mut String, v: f64) {
     };
 }
 
-/// Writes `contents` to a temporary file beside `path`, then renames it.
+/// Writes `contents` atomically (see [`brtf_io::write_atomic`]).
 pub(crate) fn write_atomically(path: &Path, contents: &[u8]) -> Result<(), WriteError> {
-    let io_error = |source| WriteError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let dir = match path.parent() {
-        Some(dir) if !dir.as_os_str().is_empty() => dir,
-        _ => Path::new("."),
-    };
-    let mut tmp = tempfile::Builder::new()
-        .prefix(".brtf-write-")
-        .suffix(".tmp")
-        .tempfile_in(dir)
-        .map_err(io_error)?;
-    tmp.write_all(contents).map_err(io_error)?;
-    tmp.as_file().sync_all().map_err(io_error)?;
-    #[cfg(unix)]
-    {
-        // tempfile creates 0600; give the result ordinary file permissions.
-        use std::os::unix::fs::PermissionsExt;
-        let mode = std::fs::metadata(path).map_or(0o644, |m| m.permissions().mode());
-        std::fs::set_permissions(tmp.path(), std::fs::Permissions::from_mode(mode))
-            .map_err(io_error)?;
-    }
-    tmp.persist(path).map_err(|e| io_error(e.error))?;
-    Ok(())
+    brtf_io::write_atomic(path, contents).map_err(|e| WriteError::Io {
+        path: e.path,
+        source: e.source,
+    })
 }
 
 #[cfg(test)]

@@ -22,7 +22,6 @@ mod theta;
 
 use brtf_fit::{FitReport, FitResult};
 use brtf_model::{Material, MaterialKind, ModelError};
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// What to export.
@@ -203,28 +202,11 @@ pub fn write_exports(
     })
 }
 
-/// Writes `bytes` to a temporary file next to `path`, then renames it.
+/// Writes `bytes` atomically (see [`brtf_io::write_atomic`]).
 fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), ExportError> {
-    let io = |source| ExportError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let dir = path.parent().filter(|d| !d.as_os_str().is_empty());
-    let file_name = path
-        .file_name()
-        .map_or_else(|| "export".into(), |n| n.to_string_lossy().into_owned());
-    let tmp = dir
-        .unwrap_or(Path::new("."))
-        .join(format!(".{file_name}.{}.tmp", std::process::id()));
-    let write = || -> std::io::Result<()> {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    };
-    write().map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        io(e)
+    brtf_io::write_atomic(path, bytes).map_err(|e| ExportError::Io {
+        path: e.path,
+        source: e.source,
     })
 }
 

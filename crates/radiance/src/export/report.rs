@@ -43,16 +43,24 @@ pub(crate) fn provenance(result: &FitResult) -> Vec<String> {
                 ascii(&f.path),
                 sig(f.theta_in, 4),
                 sig(f.phi_in, 4),
-                ascii(&f.quantity),
+                ascii(&f.conversion.to_string()),
                 f.samples,
                 ascii(f.sha256.get(..16).unwrap_or(&f.sha256))
             ));
         }
     }
-    if !result.selections.is_empty() {
+    if !result.recipe.selections.is_empty() {
         lines.push(format!(
             "Selections: {}.",
-            ascii(&result.selections.join("; "))
+            ascii(
+                &result
+                    .recipe
+                    .selections
+                    .iter()
+                    .map(|g| g.to_string())
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            )
         ));
     }
     lines
@@ -183,7 +191,7 @@ pub(crate) fn fit_caveats(report: &FitReport) -> Vec<String> {
     let mut out: Vec<String> = report
         .warnings
         .iter()
-        .map(|w| format!("fit: {}", ascii(w)))
+        .map(|w| format!("fit: {}", ascii(&w.to_string())))
         .collect();
     if !report.termination.converged() {
         out.push(format!(

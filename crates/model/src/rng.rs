@@ -1,4 +1,5 @@
-//! A small seeded random number generator.
+//! brtf's one seeded random number generator (the tracer's Monte Carlo,
+//! synthetic measurement noise, test materials).
 //!
 //! Every pixel, gonio direction or sample gets its own stream, seeded
 //! from `(seed, stream index)`, so results do not depend on how rayon
@@ -31,6 +32,12 @@ impl Rng {
         }
     }
 
+    /// The plain SplitMix64 sequence started at `state` (no stream mixing):
+    /// for sequences that must stay as earlier brtf versions drew them.
+    pub fn from_state(state: u64) -> Rng {
+        Rng { state }
+    }
+
     /// The next 64 random bits.
     #[inline]
     pub fn next_u64(&mut self) -> u64 {
@@ -42,6 +49,19 @@ impl Rng {
     #[inline]
     pub fn uniform(&mut self) -> f64 {
         (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    }
+
+    /// Uniform in (0, 1): the midpoints of the 2⁵³ cells, never 0, so
+    /// its logarithm is finite.
+    #[inline]
+    pub fn uniform_open(&mut self) -> f64 {
+        ((self.next_u64() >> 11) as f64 + 0.5) * (1.0 / (1u64 << 53) as f64)
+    }
+
+    /// A standard normal deviate (Box-Muller, one of the pair).
+    pub fn normal(&mut self) -> f64 {
+        let (a, b) = (self.uniform_open(), self.uniform_open());
+        (-2.0 * a.ln()).sqrt() * (std::f64::consts::TAU * b).cos()
     }
 
     /// Two uniform numbers in [0, 1).
@@ -74,5 +94,20 @@ mod tests {
             sum += u;
         }
         assert!((sum / n as f64 - 0.5).abs() < 0.005);
+    }
+
+    #[test]
+    fn normal_has_unit_variance() {
+        let mut rng = Rng::from_state(11);
+        let n = 100_000;
+        let (mut s1, mut s2) = (0.0, 0.0);
+        for _ in 0..n {
+            let z = rng.normal();
+            s1 += z;
+            s2 += z * z;
+        }
+        let mean = s1 / n as f64;
+        assert!(mean.abs() < 0.01, "{mean}");
+        assert!((s2 / n as f64 - 1.0).abs() < 0.02);
     }
 }

@@ -1,0 +1,147 @@
+//! What decides a fit ([`FitConfig`], [`RobustLoss`]) and why one could
+//! not run ([`FitError`]).
+
+use crate::problem::ResidualKind;
+use brtf_model::{EvalOptions, MaterialKind};
+use serde::{Deserialize, Serialize};
+
+/// Robust loss, applied by iteratively reweighting the residuals.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+pub enum RobustLoss {
+    /// Plain least squares.
+    #[default]
+    None,
+    /// Huber with threshold `c` in robust standard deviations.
+    Huber(f64),
+    /// Cauchy with scale `c` in robust standard deviations.
+    Cauchy(f64),
+}
+
+/// Everything that decides a fit.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FitConfig {
+    /// The model.
+    #[serde(with = "crate::serde_kind")]
+    pub kind: MaterialKind,
+    /// Variant, Fresnel constant and source size of the model.
+    #[serde(with = "options_serde")]
+    pub options: EvalOptions,
+    /// Orientation vector of the `*2` types.
+    pub orientation: [f64; 3],
+    /// Tie R = G = B.
+    pub gray: bool,
+    /// Fit a free overall scale (raw-signal data of unknown scale).
+    pub free_scale: bool,
+    /// How model and data are compared.
+    pub residual: ResidualKind,
+    /// Floor (same unit as the data) for relative and log residuals;
+    /// `None` picks 10% of the data's 10th percentile.
+    pub floor: Option<f64>,
+    /// Robust loss.
+    pub loss: RobustLoss,
+    /// Try several starting roughnesses and keep the best.
+    pub multistart: bool,
+}
+
+impl FitConfig {
+    /// Defaults for `kind`: radiance variant, RGB, absolute residuals, multi-start.
+    pub fn new(kind: MaterialKind) -> FitConfig {
+        FitConfig {
+            kind,
+            options: EvalOptions::default(),
+            orientation: [1.0, 0.0, 0.0],
+            gray: false,
+            free_scale: false,
+            residual: ResidualKind::Absolute,
+            floor: None,
+            loss: RobustLoss::None,
+            multistart: true,
+        }
+    }
+}
+
+mod options_serde {
+    use brtf_model::{EvalOptions, Variant};
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    #[derive(Serialize, Deserialize)]
+    struct Options {
+        variant: String,
+        fresnel_k: f64,
+        source_omega: f64,
+        flat: bool,
+        source_jitter: f64,
+    }
+
+    pub fn serialize<S: Serializer>(o: &EvalOptions, s: S) -> Result<S::Ok, S::Error> {
+        Options {
+            variant: o.variant.name().into(),
+            fresnel_k: o.fresnel_k,
+            source_omega: o.source_omega,
+            flat: o.flat,
+            source_jitter: o.source_jitter,
+        }
+        .serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<EvalOptions, D::Error> {
+        let o = Options::deserialize(d)?;
+        let variant: Variant = o.variant.parse().map_err(serde::de::Error::custom)?;
+        Ok(EvalOptions {
+            variant,
+            fresnel_k: o.fresnel_k,
+            source_omega: o.source_omega,
+            flat: o.flat,
+            source_jitter: o.source_jitter,
+        })
+    }
+}
+
+/// Why a fit could not run.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum FitError {
+    /// No samples are left after the selections.
+    #[error("{origin}: no samples left to fit after the selections ({gates})")]
+    EmptySelection {
+        /// The data's origin.
+        origin: String,
+        /// The selections applied.
+        gates: String,
+    },
+    /// Every value is zero or negative.
+    #[error("{origin}: all {count} values are zero or negative; nothing to fit")]
+    AllZero {
+        /// The data's origin.
+        origin: String,
+        /// How many samples.
+        count: usize,
+    },
+    /// A value is NaN or infinite.
+    #[error("{origin}: sample {index} has a non-finite value or weight")]
+    NonFinite {
+        /// The data's origin.
+        origin: String,
+        /// Sample index.
+        index: usize,
+    },
+    /// A transmitting model needs back-hemisphere data.
+    #[error("{origin}: a {kind} fit needs transmission data (back hemisphere), found none")]
+    NoTransmission {
+        /// The data's origin.
+        origin: String,
+        /// The model.
+        kind: MaterialKind,
+    },
+    /// Incidences differ in channel count.
+    #[error("incidences mix single-channel and RGB data")]
+    MixedChannels,
+    /// The optimiser failed at the start.
+    #[error("{origin}: the fit could not start: {reason}")]
+    Failed {
+        /// The data's origin.
+        origin: String,
+        /// What went wrong.
+        reason: String,
+    },
+}

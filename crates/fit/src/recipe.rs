@@ -1,0 +1,421 @@
+//! The typed recipe that turns a measurement file into the fitted
+//! quantity, and the one function that applies it
+//! ([`Recipe::prepare`]). `brtf fit`, the plots and `brtf check` all
+//! rebuild their data through it, from the recipe stored in `fit.json`,
+//! so they cannot disagree.
+//!
+//! In order:
+//! 1. **Colour**: three-channel data are taken as recorded.
+//! 2. **Weights**: solid angles of the full layout (the file's Voronoi
+//!    cells, else computed), before any selection; or uniform.
+//! 3. **Conversion** to the fitted quantity ([`Conversion`]): BSDF as is;
+//!    DSF ÷ |cos θ_out|; raw signal ÷ |cos θ_out| and ÷ the beam integral,
+//!    or ÷ the instrument scale K of a known reflectance, or with a free
+//!    fitted scale when neither is known.
+//! 4. **Selections** ([`Gate`]), in order, each with the number it removed.
+
+use crate::data::{FitSample, GateCount, IncidenceData, Weighting};
+use brtf_gonio::{Gate, GateContext, Measurement, Quantity, SolidAngleSource};
+use serde::{Deserialize, Serialize};
+
+/// How the scale of raw-signal files is fixed.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "rule", rename_all = "snake_case")]
+pub enum ScaleRule {
+    /// As each file says: its beam integral when it has one, else a free
+    /// fitted scale.
+    FromFiles,
+    /// Divide raw signal by this beam integral (overrides the files').
+    BeamIntegral {
+        /// The beam integral, in the files' unit.
+        value: f64,
+    },
+    /// Divide raw signal by K, the instrument scale that gives the
+    /// directional-hemispherical reflectance `rho` at `theta_in`.
+    KnownReflectance {
+        /// The known ρ_dh.
+        rho: f64,
+        /// Its incidence, degrees.
+        theta_in: f64,
+        /// The instrument scale K found from it.
+        k: f64,
+    },
+}
+
+/// How the colour channels are read.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ColourConversion {
+    /// As recorded: three channels are taken as Radiance RGB, one as grey.
+    AsRecorded,
+}
+
+/// Which weights the fit gives the samples.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum WeightRule {
+    /// Each sample's solid angle (the file's cells, else computed).
+    SolidAngle,
+    /// Every sample weighs 1.
+    Uniform,
+}
+
+/// Everything that decides how a measurement file becomes fitted data.
+/// The residual kind, floor and loss are the fit's ([`crate::FitConfig`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Recipe {
+    /// How raw signal gets its scale.
+    pub scale: ScaleRule,
+    /// How the channels are read.
+    pub colour: ColourConversion,
+    /// The selections, in the order they are applied.
+    pub selections: Vec<Gate>,
+    /// The fit's weights.
+    pub weights: WeightRule,
+}
+
+/// Where a beam integral came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BeamOrigin {
+    /// The file's header.
+    File,
+    /// The `--beam-integral` option.
+    Option,
+}
+
+/// What the raw signal of a file was divided by.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "by", rename_all = "snake_case")]
+pub enum RawScale {
+    /// A beam integral: the result is the absolute BSDF.
+    BeamIntegral {
+        /// The beam integral.
+        value: f64,
+        /// Where it came from.
+        origin: BeamOrigin,
+    },
+    /// The instrument scale K of a known reflectance: absolute BSDF.
+    KnownReflectance {
+        /// K, in the files' unit.
+        k: f64,
+        /// The known ρ_dh.
+        rho: f64,
+        /// Its incidence, degrees.
+        theta_in: f64,
+    },
+    /// Nothing: the data stay in the file's unit and the fit has a free
+    /// scale.
+    Free,
+}
+
+/// How one file's values became the fitted quantity.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "quantity", rename_all = "snake_case")]
+pub enum Conversion {
+    /// The file holds the BSDF: used as it is.
+    Bsdf,
+    /// The file holds the DSF: divided by |cos θ_out|.
+    Dsf,
+    /// The file holds raw detector signal: divided by |cos θ_out| and by
+    /// `scale`.
+    Raw {
+        /// The file's unit.
+        unit: String,
+        /// What else it was divided by.
+        scale: RawScale,
+    },
+}
+
+impl Conversion {
+    /// True when the result is in the file's raw unit (free scale).
+    pub fn is_free_scale(&self) -> bool {
+        matches!(
+            self,
+            Conversion::Raw {
+                scale: RawScale::Free,
+                ..
+            }
+        )
+    }
+
+    /// The unit of the converted values.
+    pub fn unit(&self) -> DataUnit {
+        match self {
+            Conversion::Raw {
+                unit,
+                scale: RawScale::Free,
+            } => DataUnit::RawPerCos(unit.clone()),
+            _ => DataUnit::Bsdf,
+        }
+    }
+}
+
+impl std::fmt::Display for Conversion {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Conversion::Bsdf => f.write_str("BSDF"),
+            Conversion::Dsf => f.write_str("DSF, divided by |cos θ_out|"),
+            Conversion::Raw { unit, scale } => match scale {
+                RawScale::BeamIntegral { value, .. } => {
+                    write!(f, "raw [{unit}] ÷ beam integral {value} ÷ |cos θ_out|")
+                }
+                RawScale::KnownReflectance { k, rho, theta_in } => write!(
+                    f,
+                    "raw [{unit}] ÷ |cos θ_out| ÷ K = {k:e} from --rho {rho}@{theta_in}"
+                ),
+                RawScale::Free => {
+                    write!(f, "raw [{unit}] ÷ |cos θ_out|, free scale (no beam integral)")
+                }
+            },
+        }
+    }
+}
+
+/// The unit of converted values.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum DataUnit {
+    /// BSDF in 1/sr.
+    Bsdf,
+    /// Raw signal ÷ |cos θ_out| in the file's unit (the model carries the
+    /// free scale).
+    RawPerCos(String),
+}
+
+impl DataUnit {
+    /// Axis title for values of this unit.
+    pub fn axis(&self) -> String {
+        match self {
+            DataUnit::Bsdf => "BSDF [1/sr]".into(),
+            DataUnit::RawPerCos(u) => format!("raw signal ÷ |cos θ_out| [{u}]"),
+        }
+    }
+
+    /// Axis title for a hemispherical integral Σ value·|cos θ|·ΔΩ.
+    pub fn integral_axis(&self) -> String {
+        match self {
+            DataUnit::Bsdf => "ρ_dh (directional-hemispherical reflectance) [–]".into(),
+            DataUnit::RawPerCos(u) => format!("Σ raw signal · ΔΩ [{u}·sr] (no beam integral)"),
+        }
+    }
+}
+
+/// Why a measurement could not be prepared.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum RecipeError {
+    /// A conversion failed (e.g. an invalid beam integral).
+    #[error("{origin}: {source}")]
+    Convert {
+        /// The file.
+        origin: String,
+        /// What went wrong.
+        source: brtf_gonio::ConvertError,
+    },
+    /// A raw-signal scale was given for data that are not raw signal.
+    #[error("{origin}: {what} applies to raw-signal files, but this file holds the {quantity}")]
+    ScaleNotRaw {
+        /// The file.
+        origin: String,
+        /// The option (`--beam-integral`, `--rho`).
+        what: &'static str,
+        /// What the file holds.
+        quantity: &'static str,
+    },
+}
+
+/// One measurement after the recipe: every sample of the file, converted,
+/// with the gate that removed it (if any).
+#[derive(Debug, Clone)]
+pub struct PreparedMeasurement {
+    /// Where it came from.
+    pub source: String,
+    /// The converted measurement, every sample in file order, each with
+    /// its solid angle.
+    pub measurement: Measurement,
+    /// How the values were converted.
+    pub conversion: Conversion,
+    /// Per sample: the index into the recipe's selections of the gate that
+    /// removed it, `None` when it is fitted.
+    pub removed_by: Vec<Option<usize>>,
+    /// Each selection with the number of samples it removed.
+    pub gates: Vec<GateCount>,
+    /// Which weights the fitted samples carry.
+    pub weighting: Weighting,
+}
+
+impl Recipe {
+    /// Applies the recipe to `measurement`, read from `source`.
+    pub fn prepare(
+        &self,
+        mut measurement: Measurement,
+        source: &str,
+    ) -> Result<PreparedMeasurement, RecipeError> {
+        // The weights describe the full layout, so they come first.
+        let solid_angles = measurement.fill_solid_angles();
+        let weighting = match (self.weights, solid_angles) {
+            (WeightRule::Uniform, _) => Weighting::Uniform,
+            (WeightRule::SolidAngle, SolidAngleSource::File) => Weighting::FileSolidAngles,
+            (WeightRule::SolidAngle, SolidAngleSource::Computed) => Weighting::ComputedSolidAngles,
+        };
+        let (measurement, conversion) = self.convert(&measurement, source)?;
+        let context = GateContext::of(&measurement);
+        let mut removed_by = vec![None; measurement.len()];
+        let mut gates = Vec::with_capacity(self.selections.len());
+        for (g, gate) in self.selections.iter().enumerate() {
+            let mut removed = 0;
+            for (sample, slot) in measurement.samples.iter().zip(removed_by.iter_mut()) {
+                if slot.is_none() && !gate.keeps(sample, &context) {
+                    *slot = Some(g);
+                    removed += 1;
+                }
+            }
+            gates.push(GateCount {
+                gate: *gate,
+                removed,
+            });
+        }
+        Ok(PreparedMeasurement {
+            source: source.to_string(),
+            measurement,
+            conversion,
+            removed_by,
+            gates,
+            weighting,
+        })
+    }
+
+    /// Step 3: the fitted quantity.
+    fn convert(
+        &self,
+        m: &Measurement,
+        source: &str,
+    ) -> Result<(Measurement, Conversion), RecipeError> {
+        let failed = |e| RecipeError::Convert {
+            origin: source.to_string(),
+            source: e,
+        };
+        let not_raw = |what| RecipeError::ScaleNotRaw {
+            origin: source.to_string(),
+            what,
+            quantity: m.quantity.name(),
+        };
+        let (unit, file_beam) = match &m.quantity {
+            Quantity::Raw {
+                unit,
+                beam_integral,
+            } => (unit.clone(), *beam_integral),
+            other => {
+                return match self.scale {
+                    ScaleRule::BeamIntegral { .. } => Err(not_raw("--beam-integral")),
+                    ScaleRule::KnownReflectance { .. } => Err(not_raw("--rho")),
+                    ScaleRule::FromFiles if *other == Quantity::Dsf => Ok((
+                        m.to_bsdf().map_err(failed)?.measurement,
+                        Conversion::Dsf,
+                    )),
+                    ScaleRule::FromFiles => Ok((m.clone(), Conversion::Bsdf)),
+                };
+            }
+        };
+        let scale = match (self.scale, file_beam) {
+            (ScaleRule::BeamIntegral { value }, _) => RawScale::BeamIntegral {
+                value,
+                origin: BeamOrigin::Option,
+            },
+            (ScaleRule::FromFiles, Some(value)) => RawScale::BeamIntegral {
+                value,
+                origin: BeamOrigin::File,
+            },
+            (ScaleRule::FromFiles, None) => RawScale::Free,
+            (ScaleRule::KnownReflectance { rho, theta_in, k }, _) => {
+                RawScale::KnownReflectance { k, rho, theta_in }
+            }
+        };
+        let beam = match scale {
+            RawScale::BeamIntegral { value, .. } => value,
+            _ => 1.0,
+        };
+        let mut converted = m.raw_to_bsdf(beam).map_err(failed)?.measurement;
+        if let RawScale::KnownReflectance { k, .. } = scale {
+            divide(&mut converted, k);
+        }
+        Ok((converted, Conversion::Raw { unit, scale }))
+    }
+}
+
+/// Divides every used value of `m` by `k`.
+fn divide(m: &mut Measurement, k: f64) {
+    let channels = m.channels.count();
+    for sample in &mut m.samples {
+        for v in &mut sample.values[..channels] {
+            *v /= k;
+        }
+    }
+}
+
+impl PreparedMeasurement {
+    /// Values per sample (1 or 3).
+    pub fn channels(&self) -> usize {
+        self.measurement.channels.count().clamp(1, 3)
+    }
+
+    /// Samples the fit uses: `(index in the file, sample)`.
+    pub fn fitted(&self) -> impl Iterator<Item = (usize, &brtf_gonio::Sample)> {
+        self.measurement
+            .samples
+            .iter()
+            .zip(&self.removed_by)
+            .enumerate()
+            .filter(|(_, (_, removed))| removed.is_none())
+            .map(|(i, (s, _))| (i, s))
+    }
+
+    /// How many samples the fit uses.
+    pub fn fitted_count(&self) -> usize {
+        self.removed_by.iter().filter(|r| r.is_none()).count()
+    }
+
+    /// Divides every value by the instrument scale `k` of a known
+    /// reflectance, as [`Recipe::prepare`] does for
+    /// [`ScaleRule::KnownReflectance`] (the same operations, so the same
+    /// numbers). Only free-scale raw data can be rescaled.
+    pub fn rescale_known_reflectance(&mut self, k: f64, rho: f64, theta_in: f64) -> bool {
+        let Conversion::Raw { unit, scale } = &self.conversion else {
+            return false;
+        };
+        if *scale != RawScale::Free {
+            return false;
+        }
+        divide(&mut self.measurement, k);
+        self.conversion = Conversion::Raw {
+            unit: unit.clone(),
+            scale: RawScale::KnownReflectance { k, rho, theta_in },
+        };
+        true
+    }
+
+    /// The fitter's input: the fitted samples with their weights.
+    pub fn incidence_data(&self) -> IncidenceData {
+        let uniform = self.weighting == Weighting::Uniform;
+        IncidenceData {
+            source: self.source.clone(),
+            theta_in: self.measurement.incidence.theta_deg,
+            phi_in: self.measurement.incidence.phi_deg,
+            channels: self.channels(),
+            samples: self
+                .fitted()
+                .map(|(_, s)| FitSample {
+                    view: s.direction(),
+                    value: s.values,
+                    weight: if uniform {
+                        1.0
+                    } else {
+                        s.solid_angle_sr.unwrap_or(1.0)
+                    },
+                })
+                .collect(),
+            gates: self.gates.clone(),
+            weighting: self.weighting,
+        }
+    }
+}

@@ -1,0 +1,248 @@
+//! What one fit found: [`FitReport`] with its parameters, termination and
+//! typed warnings.
+
+use crate::data::{GateCount, Weighting};
+use levenberg_marquardt::TerminationReason;
+use serde::{Deserialize, Serialize};
+
+/// Why the optimiser stopped (from the levenberg-marquardt crate).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum Termination {
+    /// Relative reduction of the cost (ftol) or step (xtol) below tolerance.
+    Converged {
+        /// ftol criterion met.
+        ftol: bool,
+        /// xtol criterion met.
+        xtol: bool,
+    },
+    /// Residuals orthogonal to every Jacobian column to within gtol (the
+    /// cosine; 1e-6 in the final fit, where that puts the cost within about
+    /// 1e-12 of the minimum's and each parameter well under 1e-3 standard
+    /// errors from it): converged on the gradient.
+    Orthogonal,
+    /// Residuals exactly zero.
+    ResidualsZero,
+    /// Evaluation budget exhausted.
+    LostPatience,
+    /// Tolerances too tight for floating point.
+    NoImprovementPossible(String),
+    /// NaN or infinity met.
+    Numerical(String),
+    /// Anything else.
+    Other(String),
+}
+
+impl Termination {
+    pub(crate) fn from_lm(reason: &TerminationReason) -> Termination {
+        match reason {
+            TerminationReason::Converged { ftol, xtol } => Termination::Converged {
+                ftol: *ftol,
+                xtol: *xtol,
+            },
+            TerminationReason::Orthogonal => Termination::Orthogonal,
+            TerminationReason::ResidualsZero => Termination::ResidualsZero,
+            TerminationReason::LostPatience => Termination::LostPatience,
+            TerminationReason::NoImprovementPossible(s) => {
+                Termination::NoImprovementPossible((*s).into())
+            }
+            TerminationReason::Numerical(s) => Termination::Numerical((*s).into()),
+            other => Termination::Other(format!("{other:?}")),
+        }
+    }
+
+    /// The optimiser reached a stationary point (not a judgement of physics).
+    pub fn converged(&self) -> bool {
+        matches!(
+            self,
+            Termination::Converged { .. }
+                | Termination::Orthogonal
+                | Termination::ResidualsZero
+                | Termination::NoImprovementPossible(_)
+        )
+    }
+
+    /// A short label for tables.
+    pub fn label(&self) -> &'static str {
+        match self {
+            Termination::Converged { .. } => "converged",
+            Termination::Orthogonal => "converged (gradient)",
+            Termination::ResidualsZero => "residuals_zero",
+            Termination::LostPatience => "lost_patience",
+            Termination::NoImprovementPossible(_) => "no_improvement_possible",
+            Termination::Numerical(_) => "numerical",
+            Termination::Other(_) => "other",
+        }
+    }
+}
+
+/// One fitted parameter.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ParamEstimate {
+    /// Name (`red`, `spec`, `rough`, `scale`, ...).
+    pub name: String,
+    /// Fitted value.
+    pub value: f64,
+    /// Standard error from s²(JᵀJ)⁻¹ (0 for a parameter held fixed).
+    pub stderr: f64,
+    /// Heteroscedasticity-consistent standard error from the sandwich
+    /// `m/(m−n) (JᵀJ)⁻¹ (Σ rᵢ² Jᵢ Jᵢᵀ) (JᵀJ)⁻¹`, which does not assume
+    /// equal residual variances (absent in fit.json files written before
+    /// it existed: 0).
+    #[serde(default)]
+    pub stderr_robust: f64,
+    /// Ended at a physical bound (its standard error is then meaningless).
+    pub at_bound: bool,
+    /// Held fixed rather than fitted.
+    pub fixed: bool,
+}
+
+impl ParamEstimate {
+    /// The larger of the two standard errors (a non-finite one is
+    /// ignored): the one to show when the residuals' variance may not be
+    /// uniform.
+    pub fn uncertainty(&self) -> f64 {
+        [self.stderr, self.stderr_robust]
+            .into_iter()
+            .filter(|v| v.is_finite())
+            .fold(f64::NAN, f64::max)
+    }
+}
+
+/// One starting point of the multi-start and where it ended.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StartRecord {
+    /// Starting roughness (u, v).
+    pub rough: [f64; 2],
+    /// Cost reached on the subsample.
+    pub cost: f64,
+}
+
+/// The result of fitting one incidence (or all at once).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FitReport {
+    /// Where the data came from.
+    pub source: String,
+    /// Incident polar angle in degrees (NaN-free; 0 for the global fit).
+    pub theta_in: f64,
+    /// Incident azimuth in degrees.
+    pub phi_in: f64,
+    /// Every material argument by name, then `scale` when free.
+    pub params: Vec<ParamEstimate>,
+    /// The fitted material's real arguments, in Radiance order.
+    pub material_args: Vec<f64>,
+    /// Free scale (1 when not fitted).
+    pub scale: f64,
+    /// Samples used.
+    pub n_points: usize,
+    /// Selections applied before the fit, with what each removed.
+    pub gates: Vec<GateCount>,
+    /// Which weights were used.
+    pub weighting: Weighting,
+    /// RMS of `(m − y)/sqrt(y² + floor²)` over all samples and channels.
+    pub rms_rel: f64,
+    /// ½ Σ r² at the solution (the optimiser's objective).
+    pub cost: f64,
+    /// The floor used by relative/log residuals.
+    pub floor: f64,
+    /// Why the optimiser stopped.
+    pub termination: Termination,
+    /// Residual + Jacobian evaluations over all starts and passes.
+    pub evaluations: usize,
+    /// Wall time in milliseconds.
+    pub elapsed_ms: f64,
+    /// The multi-start record.
+    pub starts: Vec<StartRecord>,
+    /// Things the user should know (bounds, degenerate lobes, ...).
+    pub warnings: Vec<FitWarning>,
+}
+
+impl FitReport {
+    /// Value of the parameter called `name`.
+    pub fn value(&self, name: &str) -> Option<f64> {
+        self.params.iter().find(|p| p.name == name).map(|p| p.value)
+    }
+
+    /// Standard error of the parameter called `name`.
+    pub fn stderr(&self, name: &str) -> Option<f64> {
+        self.params
+            .iter()
+            .find(|p| p.name == name)
+            .map(|p| p.stderr)
+    }
+}
+
+impl std::fmt::Display for Termination {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.label())
+    }
+}
+
+/// A parameter whose sandwich standard error exceeds the plain one.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StderrRatio {
+    /// The parameter's name.
+    pub param: String,
+    /// `stderr_robust / stderr`.
+    pub ratio: f64,
+}
+
+/// Something the user should know about one fit. Stored typed in
+/// `fit.json`; the `Display` sentence is for people only.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "warning", rename_all = "snake_case")]
+pub enum FitWarning {
+    /// A parameter ended at a bound of its physical range.
+    AtBound {
+        /// The parameter's name.
+        param: String,
+        /// Its value.
+        value: f64,
+    },
+    /// A free scale was fitted, so colour and scale are one product.
+    FreeScaleColour,
+    /// The sandwich standard errors exceed s²(JᵀJ)⁻¹ by more than 2×.
+    UnderstatedErrors {
+        /// The parameters concerned.
+        params: Vec<StderrRatio>,
+    },
+    /// The specular part vanished, so its roughness means nothing.
+    DegenerateLobe,
+    /// The optimiser stopped without meeting a convergence test.
+    NotConverged {
+        /// Why it stopped.
+        termination: Termination,
+    },
+}
+
+impl std::fmt::Display for FitWarning {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            FitWarning::AtBound { param, value } => {
+                write!(f, "{param} = {value:.6} ended at a bound")
+            }
+            FitWarning::FreeScaleColour => f.write_str(
+                "free scale: the colour is fixed at 1, so `scale` is scale × colour; \
+                 give the beam integral or a known reflectance for absolute colour",
+            ),
+            FitWarning::UnderstatedErrors { params } => {
+                let list: Vec<String> = params
+                    .iter()
+                    .map(|p| format!("{} ({:.1}×)", p.param, p.ratio))
+                    .collect();
+                write!(
+                    f,
+                    "the residuals' variance is not uniform, so the standard errors understate \
+                     the uncertainty of {}; use stderr_robust in fit.json, or --residual log \
+                     for multiplicative noise",
+                    list.join(", ")
+                )
+            }
+            FitWarning::DegenerateLobe => {
+                f.write_str("specularity ≈ 0: the lobe is degenerate and its roughness meaningless")
+            }
+            FitWarning::NotConverged { termination } => {
+                write!(f, "optimiser stopped without converging: {termination:?}")
+            }
+        }
+    }
+}

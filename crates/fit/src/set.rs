@@ -1,0 +1,280 @@
+//! A fit set: measurement files → [`Recipe`] → per-incidence and
+//! all-incidence fits → θ_in table → [`FitResult`]. This is `brtf fit`
+//! without the command line.
+
+use crate::config::{FitConfig, FitError};
+use crate::data::IncidenceData;
+use crate::fitter::{fit_global, fit_incidence};
+use crate::recipe::{PreparedMeasurement, Recipe, RecipeError, ScaleRule};
+use crate::report::FitReport;
+use crate::result::{FIT_JSON_SCHEMA, FitResult, InputFile, Provenance, SetWarning};
+use crate::table::{Interpolation, ParamTable};
+use rayon::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// Reports the progress of a long run (the CLI draws a bar).
+pub trait Progress: Sync {
+    /// `total` steps are about to run.
+    fn begin(&self, _total: u64) {}
+    /// One step finished.
+    fn advance(&self) {}
+    /// All steps finished.
+    fn end(&self) {}
+}
+
+/// Reports nothing.
+pub struct NoProgress;
+
+impl Progress for NoProgress {}
+
+/// What a fit set needs besides the files.
+#[derive(Debug, Clone)]
+pub struct FitSetOptions {
+    /// Material name of the exports.
+    pub name: String,
+    /// The fit settings. `free_scale` forces a free scale; raw files
+    /// without a beam integral get one anyway.
+    pub config: FitConfig,
+    /// How the files become data (`scale`: [`ScaleRule::FromFiles`] or
+    /// [`ScaleRule::BeamIntegral`]).
+    pub recipe: Recipe,
+    /// A known reflectance `(ρ_dh, θ_in)` that makes raw data absolute.
+    pub known_reflectance: Option<(f64, f64)>,
+    /// θ_in interpolation of the table.
+    pub interpolation: Interpolation,
+    /// The command line, for the provenance.
+    pub command_line: Vec<String>,
+}
+
+/// Why a fit set could not be made.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum FitSetError {
+    /// No input files.
+    #[error("no measurement files given")]
+    NoInputs,
+    /// A file could not be read.
+    #[error("cannot read {}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// A file could not be parsed.
+    #[error(transparent)]
+    Read(#[from] brtf_gonio::ReadError),
+    /// A file could not be converted.
+    #[error(transparent)]
+    Recipe(#[from] RecipeError),
+    /// A fit failed.
+    #[error(transparent)]
+    Fit(#[from] FitError),
+    /// Some files are absolute and some need a free scale.
+    #[error("the files mix absolute and raw-signal data; give --beam-integral or --free-scale")]
+    MixedScale,
+    /// `--rho` on data that are already absolute.
+    #[error("--rho is for raw-signal data fitted with a free scale; these data are absolute")]
+    KnownReflectanceOnAbsoluteData,
+    /// The fitted model reflects nothing at the `--rho` incidence.
+    #[error("--rho: the fitted model has no reflectance at {0}°")]
+    NoReflectance(f64),
+}
+
+/// One input file, read and prepared.
+struct Input {
+    file: InputFile,
+    prepared: PreparedMeasurement,
+}
+
+/// Reads, prepares and fits every file; see the module docs.
+pub fn fit_set(
+    paths: &[PathBuf],
+    options: &FitSetOptions,
+    progress: &dyn Progress,
+) -> Result<FitResult, FitSetError> {
+    if paths.is_empty() {
+        return Err(FitSetError::NoInputs);
+    }
+    let mut recipe = options.recipe.clone();
+    let mut inputs: Vec<Input> = paths
+        .par_iter()
+        .map(|p| read_input(p, &recipe))
+        .collect::<Result<_, _>>()?;
+    inputs.sort_by(|a, b| a.file.theta_in.total_cmp(&b.file.theta_in));
+
+    let mut config = options.config.clone();
+    let free = inputs.iter().filter(|i| i.prepared.conversion.is_free_scale());
+    let free_count = free.count();
+    if free_count > 0 && free_count < inputs.len() && !config.free_scale {
+        return Err(FitSetError::MixedScale);
+    }
+    config.free_scale |= free_count > 0;
+
+    let mut warnings = Vec::new();
+    let (mut reports, mut global) = fit_all(&inputs, &config, progress)?;
+
+    // A known reflectance turns a free-scale fit absolute: the fitted model's
+    // ρ_dh at that incidence fixes the instrument's scale K; the data are
+    // divided by K and fitted again without a free scale.
+    if let Some((rho, theta)) = options.known_reflectance {
+        if free_count == 0 {
+            return Err(FitSetError::KnownReflectanceOnAbsoluteData);
+        }
+        let nearest = reports
+            .iter()
+            .min_by(|a, b| {
+                (a.theta_in - theta)
+                    .abs()
+                    .total_cmp(&(b.theta_in - theta).abs())
+            })
+            .expect("at least one incidence");
+        if (nearest.theta_in - theta).abs() > 5.0 {
+            warnings.push(SetWarning::RhoFarFromIncidence {
+                requested: theta,
+                used: nearest.theta_in,
+            });
+        }
+        let k = instrument_scale(&config, nearest, rho, theta)?;
+        for input in &mut inputs {
+            input.prepared.rescale_known_reflectance(k, rho, theta);
+            input.file.conversion = input.prepared.conversion.clone();
+        }
+        recipe.scale = ScaleRule::KnownReflectance {
+            rho,
+            theta_in: theta,
+            k,
+        };
+        config.free_scale = false;
+        (reports, global) = fit_all(&inputs, &config, progress)?;
+    }
+
+    let table = match ParamTable::from_reports(
+        config.kind,
+        config.orientation,
+        &reports,
+        options.interpolation,
+    ) {
+        Ok(t) => Some(t),
+        Err(e) => {
+            warnings.push(SetWarning::NoTable {
+                reason: e.to_string(),
+            });
+            None
+        }
+    };
+    Ok(FitResult {
+        schema: FIT_JSON_SCHEMA,
+        name: options.name.clone(),
+        provenance: Provenance {
+            brtf_version: env!("CARGO_PKG_VERSION").into(),
+            command_line: options.command_line.clone(),
+            created: brtf_io::utc_now_rfc3339(),
+            inputs: inputs.into_iter().map(|i| i.file).collect(),
+        },
+        recipe,
+        config,
+        incidences: reports,
+        global: Some(global),
+        table,
+        interpolation: options.interpolation,
+        warnings,
+    })
+}
+
+/// Reads one file and applies the recipe.
+fn read_input(path: &Path, recipe: &Recipe) -> Result<Input, FitSetError> {
+    let bytes = std::fs::read(path).map_err(|source| FitSetError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let measurement = brtf_gonio::read_bytes(&bytes, path)?;
+    let samples = measurement.len();
+    let source = path.display().to_string();
+    let prepared = recipe.prepare(measurement, &source)?;
+    let incidence = prepared.measurement.incidence;
+    Ok(Input {
+        file: InputFile {
+            path: source,
+            sha256: brtf_io::sha256_hex(&bytes),
+            theta_in: incidence.theta_deg,
+            phi_in: incidence.phi_deg,
+            conversion: prepared.conversion.clone(),
+            samples,
+        },
+        prepared,
+    })
+}
+
+/// K such that the data ÷ K have the reflectance `rho` at `theta`, from the
+/// free-scale fit `report` of the nearest incidence.
+fn instrument_scale(
+    config: &FitConfig,
+    report: &FitReport,
+    rho: f64,
+    theta: f64,
+) -> Result<f64, FitSetError> {
+    let material = brtf_model::Material::new(
+        config.kind,
+        &report.material_args,
+        Some(glam::DVec3::from_array(config.orientation)),
+    )
+    .map_err(|e| {
+        FitSetError::Fit(FitError::Failed {
+            origin: report.source.clone(),
+            reason: e.to_string(),
+        })
+    })?;
+    let bsdf = brtf_model::Bsdf::new(&material, &config.options);
+    let albedo = brtf_model::albedo(&bsdf, brtf_model::direction(theta, report.phi_in), 1e-6);
+    let model_rho = report.scale * (albedo.rho.iter().sum::<f64>() / 3.0);
+    let k = model_rho / rho;
+    if k.is_finite() && k > 0.0 {
+        Ok(k)
+    } else {
+        Err(FitSetError::NoReflectance(theta))
+    }
+}
+
+/// Fits every incidence and all of them at once, in parallel.
+fn fit_all(
+    inputs: &[Input],
+    config: &FitConfig,
+    progress: &dyn Progress,
+) -> Result<(Vec<FitReport>, FitReport), FitSetError> {
+    let data: Vec<IncidenceData> = inputs
+        .iter()
+        .map(|i| i.prepared.incidence_data())
+        .collect();
+    progress.begin(data.len() as u64 + 1);
+    let (reports, global) = rayon::join(
+        || {
+            data.par_iter()
+                .map(|d| {
+                    let r = fit_incidence(d, config);
+                    progress.advance();
+                    r
+                })
+                .collect::<Vec<_>>()
+        },
+        || {
+            // With one incidence the all-incidence fit is that fit.
+            if data.len() < 2 {
+                return None;
+            }
+            let r = fit_global(&data, config);
+            progress.advance();
+            Some(r)
+        },
+    );
+    progress.end();
+    let reports = reports.into_iter().collect::<Result<Vec<_>, _>>()?;
+    let global = match global {
+        Some(g) => g?,
+        None => FitReport {
+            source: "all incidences".into(),
+            ..reports[0].clone()
+        },
+    };
+    Ok((reports, global))
+}

@@ -1,0 +1,94 @@
+//! The plain-text summary `brtf fit` prints: inputs, the parameter table
+//! with standard errors, the warnings and the all-incidence material.
+
+use crate::report::FitReport;
+use crate::result::FitResult;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// The summary of `result`, written into `out`.
+pub fn summary(result: &FitResult, out: &Path) -> String {
+    let mut s = String::new();
+    let kind = result.config.kind;
+    let _ = writeln!(
+        s,
+        "brtf fit: {} {} ({} variant), {} incidence(s) -> {}",
+        result.name,
+        kind,
+        result.config.options.variant,
+        result.incidences.len(),
+        out.display()
+    );
+    for i in &result.provenance.inputs {
+        let _ = writeln!(
+            s,
+            "  {}: θ_in {}°, φ_in {}°, {} samples, {}",
+            i.path, i.theta_in, i.phi_in, i.samples, i.conversion
+        );
+    }
+    let names: Vec<&str> = result
+        .incidences
+        .first()
+        .map(|r| r.params.iter().map(|p| p.name.as_str()).collect())
+        .unwrap_or_default();
+    let _ = write!(s, "\n{:>8} {:>7}", "θ_in", "points");
+    for n in &names {
+        let _ = write!(s, " {:>17}", n);
+    }
+    let _ = writeln!(s, " {:>8} {:>8}  termination", "rms_rel", "ms");
+    let mut line = |label: String, r: &FitReport| {
+        let _ = write!(s, "{:>8} {:>7}", label, r.n_points);
+        for p in &r.params {
+            let flag = if p.at_bound {
+                "!"
+            } else if p.fixed {
+                "="
+            } else {
+                " "
+            };
+            let _ = write!(s, " {:>8.5}±{:<7.1e}{}", p.value, p.stderr, flag);
+        }
+        let _ = writeln!(
+            s,
+            " {:>8.4} {:>8.0}  {}",
+            r.rms_rel, r.elapsed_ms, r.termination
+        );
+    };
+    for r in &result.incidences {
+        line(format!("{}", r.theta_in), r);
+    }
+    if let Some(g) = &result.global {
+        line("all".into(), g);
+    }
+    let _ = writeln!(s, "(! = at a bound, = = held fixed)");
+    let global = result
+        .global
+        .iter()
+        .filter(|_| result.incidences.len() > 1);
+    let labelled = result
+        .incidences
+        .iter()
+        .map(|r| (r, format!("{} (θ_in {})", r.source, r.theta_in)))
+        .chain(global.map(|r| (r, "all incidences".to_string())));
+    let mut warnings: Vec<String> = labelled
+        .flat_map(|(r, label)| r.warnings.iter().map(move |w| format!("{label}: {w}")))
+        .collect();
+    warnings.extend(result.warnings.iter().map(|w| w.to_string()));
+    if !warnings.is_empty() {
+        let _ = writeln!(s, "\nwarnings:");
+        for w in &warnings {
+            let _ = writeln!(s, "  {w}");
+        }
+    }
+    if let Some(g) = &result.global {
+        let args: Vec<String> = g.material_args.iter().map(|a| format!("{a:.6}")).collect();
+        let _ = writeln!(
+            s,
+            "\nall-incidence material: void {kind} {} 0 0 {} {}",
+            result.name,
+            args.len(),
+            args.join(" ")
+        );
+    }
+    s
+}

@@ -1,0 +1,229 @@
+//! The arguments of `brtf fit` and the library options they mean.
+
+use crate::cmd::material::{parse_fresnel_k, parse_variant};
+use anyhow::{Result, bail};
+use brtf_fit::{
+    ColourConversion, FitConfig, FitSetOptions, Gate, Interpolation, Recipe, ResidualKind,
+    RobustLoss, ScaleRule, WeightRule,
+};
+use brtf_gonio::Hemisphere;
+use brtf_model::{MaterialKind, Variant};
+use clap::{Args, ValueEnum};
+use std::path::PathBuf;
+
+#[derive(Args, Debug)]
+pub struct FitArgs {
+    /// Measurement files, one incidence each (.mpc or pab-opto Mountain).
+    #[arg(required = true)]
+    pub files: Vec<PathBuf>,
+    /// Model to fit.
+    #[arg(long, value_parser = parse_kind)]
+    pub model: MaterialKind,
+    /// Tie R = G = B (always so for single-channel data).
+    #[arg(long)]
+    pub gray: bool,
+    /// Output folder [default: fits/<name>].
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Material name [default: the files' folder name].
+    #[arg(long)]
+    pub name: Option<String>,
+    /// Formula set: radiance (current rtrace), manual2004 or ward1992.
+    #[arg(long, default_value = "radiance", value_parser = parse_variant)]
+    pub variant: Variant,
+    /// Fresnel constant for roughness-0 surfaces: classic, pyradiance or a number.
+    #[arg(long, default_value = "classic", value_parser = parse_fresnel_k)]
+    pub fresnel_k: f64,
+    /// Solid angle of the instrument's source in sr, modelled as rtrace's widening.
+    #[arg(long, default_value_t = 0.0)]
+    pub source_omega: f64,
+    /// Orientation vector of the *2 models, `x,y,z`.
+    #[arg(
+        long,
+        default_value = "1,0,0",
+        value_delimiter = ',',
+        allow_hyphen_values = true
+    )]
+    pub orientation: Vec<f64>,
+    /// How model and data are compared.
+    #[arg(long, value_enum, default_value_t = ResidualArg::Absolute)]
+    pub residual: ResidualArg,
+    /// Floor for relative/log residuals, in the data's unit [default: 10% of the 10th percentile].
+    #[arg(long)]
+    pub floor: Option<f64>,
+    /// Robust loss: none, huber[:C] or cauchy[:C] (C in robust standard deviations).
+    #[arg(long, default_value = "none", value_parser = parse_loss)]
+    pub loss: RobustLoss,
+    /// Fit weights: the samples' solid angles (file Voronoi cells, else computed) or uniform.
+    #[arg(long, value_enum, default_value_t = WeightsArg::SolidAngle)]
+    pub weights: WeightsArg,
+    /// Start from the data-driven values only (no multi-start over roughness).
+    #[arg(long)]
+    pub no_multistart: bool,
+    /// Largest θ_out (from the nearer normal) used, degrees.
+    #[arg(long, default_value_t = brtf_gonio::DEFAULT_THETA_CAP_DEG)]
+    pub theta_cap: f64,
+    /// Half-angle of the cone around the incident beam that is masked, degrees (0: none).
+    #[arg(long, default_value_t = 3.0)]
+    pub beam_mask: f64,
+    /// Hemisphere(s) used [default: front for opaque models, both for trans].
+    #[arg(long, value_enum)]
+    pub hemisphere: Option<HemisphereArg>,
+    /// Drop samples whose value is below this (in the data's unit).
+    #[arg(long)]
+    pub min_value: Option<f64>,
+    /// Beam integral for raw-signal files (makes the fit absolute); overrides the file's.
+    #[arg(long)]
+    pub beam_integral: Option<f64>,
+    /// A known directional-hemispherical reflectance `VALUE@THETA` (e.g.
+    /// `0.85@30`) that makes a raw-signal fit absolute.
+    #[arg(long, value_parser = parse_rho)]
+    pub rho: Option<(f64, f64)>,
+    /// Fit a free overall scale even when the data are absolute.
+    #[arg(long)]
+    pub free_scale: bool,
+    /// θ_in interpolation of the parameters.
+    #[arg(long, value_enum, default_value_t = InterpArg::Pchip)]
+    pub interpolation: InterpArg,
+    /// Worker threads [default: all cores].
+    #[arg(long)]
+    pub jobs: Option<usize>,
+    /// Do not write the Radiance exports.
+    #[arg(long)]
+    pub no_export: bool,
+    /// Do not draw the plots.
+    #[arg(long)]
+    pub no_plots: bool,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum ResidualArg {
+    Relative,
+    Absolute,
+    Log,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, ValueEnum)]
+pub enum WeightsArg {
+    SolidAngle,
+    Uniform,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, ValueEnum)]
+pub enum HemisphereArg {
+    Front,
+    Back,
+    Both,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum InterpArg {
+    Pchip,
+    Linear,
+}
+
+fn parse_kind(s: &str) -> Result<MaterialKind, String> {
+    s.parse()
+}
+
+fn parse_rho(s: &str) -> Result<(f64, f64), String> {
+    let (value, theta) = s
+        .split_once('@')
+        .ok_or("expected VALUE@THETA, e.g. 0.85@30")?;
+    let value: f64 = value
+        .parse()
+        .map_err(|_| format!("bad reflectance `{value}`"))?;
+    let theta: f64 = theta.parse().map_err(|_| format!("bad angle `{theta}`"))?;
+    if !(value > 0.0 && value <= 1.0 && (0.0..90.0).contains(&theta)) {
+        return Err("need 0 < VALUE ≤ 1 and 0 ≤ THETA < 90".into());
+    }
+    Ok((value, theta))
+}
+
+fn parse_loss(s: &str) -> Result<RobustLoss, String> {
+    let (name, c) = match s.split_once(':') {
+        Some((n, c)) => (
+            n,
+            Some(
+                c.parse::<f64>()
+                    .map_err(|_| format!("bad loss scale `{c}`"))?,
+            ),
+        ),
+        None => (s, None),
+    };
+    match name {
+        "none" => Ok(RobustLoss::None),
+        "huber" => Ok(RobustLoss::Huber(c.unwrap_or(1.345))),
+        "cauchy" => Ok(RobustLoss::Cauchy(c.unwrap_or(2.385))),
+        _ => Err(format!(
+            "expected none, huber[:C] or cauchy[:C], found `{s}`"
+        )),
+    }
+}
+
+impl FitArgs {
+    /// The library's options for these arguments.
+    pub fn options(&self, name: String) -> Result<FitSetOptions> {
+        let [x, y, z] = self.orientation[..] else {
+            bail!("--orientation needs three numbers x,y,z, not all zero");
+        };
+        if [x, y, z].iter().all(|c| *c == 0.0) {
+            bail!("--orientation needs three numbers x,y,z, not all zero");
+        }
+        let hemisphere = match self.hemisphere {
+            Some(HemisphereArg::Front) => Some(Hemisphere::Front),
+            Some(HemisphereArg::Back) => Some(Hemisphere::Back),
+            Some(HemisphereArg::Both) => None,
+            None if self.model.is_transmitting() => None,
+            None => Some(Hemisphere::Front),
+        };
+        let mut selections = vec![Gate::Unavailable];
+        selections.extend(hemisphere.map(|keep| Gate::Hemisphere { keep }));
+        selections.push(Gate::ThetaCap {
+            max_deg: self.theta_cap,
+        });
+        if self.beam_mask > 0.0 {
+            selections.push(Gate::BeamMask {
+                half_angle_deg: self.beam_mask,
+            });
+        }
+        selections.extend(self.min_value.map(|min| Gate::MinValue { min }));
+        let mut config = FitConfig::new(self.model);
+        config.options.variant = self.variant;
+        config.options.fresnel_k = self.fresnel_k;
+        config.options.source_omega = self.source_omega;
+        config.orientation = [x, y, z];
+        config.gray = self.gray;
+        config.free_scale = self.free_scale;
+        config.residual = match self.residual {
+            ResidualArg::Relative => ResidualKind::Relative,
+            ResidualArg::Absolute => ResidualKind::Absolute,
+            ResidualArg::Log => ResidualKind::Log,
+        };
+        config.floor = self.floor;
+        config.loss = self.loss;
+        config.multistart = !self.no_multistart;
+        Ok(FitSetOptions {
+            name,
+            config,
+            recipe: Recipe {
+                scale: match self.beam_integral {
+                    Some(value) => ScaleRule::BeamIntegral { value },
+                    None => ScaleRule::FromFiles,
+                },
+                colour: ColourConversion::AsRecorded,
+                selections,
+                weights: match self.weights {
+                    WeightsArg::SolidAngle => WeightRule::SolidAngle,
+                    WeightsArg::Uniform => WeightRule::Uniform,
+                },
+            },
+            known_reflectance: self.rho,
+            interpolation: match self.interpolation {
+                InterpArg::Pchip => Interpolation::Pchip,
+                InterpArg::Linear => Interpolation::Linear,
+            },
+            command_line: std::env::args().collect(),
+        })
+    }
+}
