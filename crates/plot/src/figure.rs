@@ -27,6 +27,9 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 /// The font family every chart uses.
 pub const FONT: &str = "sans-serif";
 
+/// A region of a chart's backend, in pixels: the whole chart or a part.
+pub type Area<DB> = DrawingArea<DB, Shift>;
+
 /// Registers the embedded DejaVu Sans faces (once per process).
 pub fn register_fonts() {
     static DONE: OnceLock<()> = OnceLock::new();
@@ -89,7 +92,7 @@ impl Canvas {
     /// `upper_left` (on the root area).
     pub fn place<DB: DrawingBackend>(
         &self,
-        root: &DrawingArea<DB, Shift>,
+        root: &Area<DB>,
         upper_left: (i32, i32),
         raster: Raster,
     ) -> Result<(), String> {
@@ -131,14 +134,13 @@ fn placeholder(id: u8) -> RGBColor {
 pub trait Chart: Sync {
     /// File stem (`map-t30`, `params`, ...).
     fn name(&self) -> String;
-    /// Size in pixels (the SVG's view box).
-    fn size(&self) -> (u32, u32);
+    /// Size in pixels (the SVG's view box); landscape unless the chart's
+    /// content asks for another shape.
+    fn size(&self) -> (u32, u32) {
+        (1000, 640)
+    }
     /// Draws on `root`, already filled white.
-    fn draw<DB: DrawingBackend>(
-        &self,
-        root: &DrawingArea<DB, Shift>,
-        canvas: &Canvas,
-    ) -> Result<(), String>;
+    fn draw<DB: DrawingBackend>(&self, root: &Area<DB>, canvas: &Canvas) -> Result<(), String>;
 }
 
 fn draw_error(chart: &impl Chart, message: String) -> PlotError {

@@ -10,12 +10,15 @@
 //! gives at least 60 fitted samples and covers 90% of the 2° steps of θ_out
 //! that 3° covers. The model is evaluated exactly in the plane.
 
-use super::{LABEL, SMALL, TICK, fmt, incidence_label, log_range, titled};
+use super::{
+    CartesianChart, Frame, SMALL, fmt, incidence_label, legend_circle, legend_line, legend_swatch,
+    log_range, mesh, series_legend, titled,
+};
 use crate::colour::{self, DATA, GUIDE, MASKED, MODEL, SHADE};
-use crate::figure::{Canvas, Chart, FONT, OrMsg};
+use crate::figure::{Area, Canvas, Chart, FONT, OrMsg};
 use crate::prepare::{Incidence, PlotSample};
 use glam::DVec3;
-use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
 /// Plane tolerances tried, degrees.
@@ -24,6 +27,29 @@ const TOLERANCES: [f64; 6] = [0.25, 0.5, 1.0, 1.5, 2.0, 3.0];
 const ENOUGH: usize = 60;
 /// Decades shown below the top of the log axis.
 const DECADES: f64 = 6.0;
+
+/// A cut chart: signed in-plane θ_out against the BSDF on a log axis.
+type CutAxes<'a, DB> = CartesianChart<'a, DB, RangedCoordf64, LogCoord<f64>>;
+
+/// Both cut charts' axes in `area`, drawn: `x` the range of in-plane
+/// angles, `(lo, hi)` that of the values, `y_desc` the data's unit.
+fn cut_axes<'a, DB: DrawingBackend>(
+    area: &'a Area<DB>,
+    x: (f64, f64),
+    (lo, hi): (f64, f64),
+    y_desc: &str,
+) -> Result<CutAxes<'a, DB>, String> {
+    let mut chart = Frame::FULL.chart(area, x.0..x.1, (lo..hi).log_scale())?;
+    mesh(
+        &mut chart,
+        "θ_out in the plane of incidence [°]  (− towards the light, + mirror side)",
+        y_desc,
+    )
+    .x_labels(13)
+    .draw()
+    .msg()?;
+    Ok(chart)
+}
 
 /// The cut geometry of one incidence.
 pub struct Plane {
@@ -166,15 +192,7 @@ impl Chart for CutChart<'_> {
         format!("cut-{}", self.inc.tag)
     }
 
-    fn size(&self) -> (u32, u32) {
-        (1000, 640)
-    }
-
-    fn draw<DB: DrawingBackend>(
-        &self,
-        root: &DrawingArea<DB, Shift>,
-        _canvas: &Canvas,
-    ) -> Result<(), String> {
+    fn draw<DB: DrawingBackend>(&self, root: &Area<DB>, _canvas: &Canvas) -> Result<(), String> {
         let inc = self.inc;
         let cut = CutData::of(inc, self.tolerance);
         let positive = |v: f64| v.is_finite() && v > 0.0;
@@ -186,26 +204,7 @@ impl Chart for CutChart<'_> {
             DECADES,
         );
         let area = titled(root, &self.title)?;
-        let mut chart = ChartBuilder::on(&area)
-            .margin(14)
-            .margin_right(28)
-            .x_label_area_size(52)
-            .y_label_area_size(84)
-            .build_cartesian_2d(cut.range.0..cut.range.1, (lo..hi).log_scale())
-            .msg()?;
-        chart
-            .configure_mesh()
-            .x_desc("θ_out in the plane of incidence [°]  (− towards the light, + mirror side)")
-            .y_desc(inc.unit.axis())
-            .x_labels(13)
-            .x_label_formatter(&|x| fmt(*x))
-            .y_label_formatter(&|y| fmt(*y))
-            .axis_desc_style((FONT, LABEL))
-            .label_style((FONT, TICK))
-            .bold_line_style(RGBColor(226, 226, 226))
-            .light_line_style(TRANSPARENT)
-            .draw()
-            .msg()?;
+        let mut chart = cut_axes(&area, cut.range, (lo, hi), &inc.unit.axis())?;
 
         let masked = cut.masked_ranges(inc);
         if !masked.is_empty() {
@@ -217,7 +216,7 @@ impl Chart for CutChart<'_> {
                 )
                 .msg()?
                 .label("masked range (not fitted)")
-                .legend(|(x, y)| Rectangle::new([(x, y - 6), (x + 20, y + 6)], SHADE.filled()));
+                .legend(legend_swatch(SHADE.filled()));
         }
         let mut marks = vec![(inc.theta_in, "mirror"), (-inc.theta_in, "light")];
         if cut.range.1 > 90.0 {
@@ -261,7 +260,7 @@ impl Chart for CutChart<'_> {
                 )
                 .msg()?
                 .label("data, not fitted")
-                .legend(|(x, y)| Circle::new((x + 10, y), 3, MASKED.stroke_width(1)));
+                .legend(legend_circle(3, MASKED.stroke_width(1)));
         }
         let mut label = format!(
             "data, fitted (within ±{}° of the plane)",
@@ -279,7 +278,7 @@ impl Chart for CutChart<'_> {
             )
             .msg()?
             .label(label)
-            .legend(|(x, y)| Circle::new((x + 10, y), 3, DATA.filled()));
+            .legend(legend_circle(3, DATA.filled()));
         let model_label = if inc.scale != 1.0 {
             format!("model: {} × f (fitted free scale)", fmt(inc.scale))
         } else {
@@ -292,15 +291,8 @@ impl Chart for CutChart<'_> {
             ))
             .msg()?
             .label(model_label)
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], MODEL.stroke_width(2)));
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .background_style(WHITE.mix(0.9))
-            .border_style(BLACK)
-            .label_font((FONT, SMALL))
-            .draw()
-            .msg()
+            .legend(legend_line(MODEL.stroke_width(2)));
+        series_legend(&mut chart).draw().msg()
     }
 }
 
@@ -319,15 +311,7 @@ impl Chart for CutsChart<'_> {
         "cuts".into()
     }
 
-    fn size(&self) -> (u32, u32) {
-        (1000, 640)
-    }
-
-    fn draw<DB: DrawingBackend>(
-        &self,
-        root: &DrawingArea<DB, Shift>,
-        _canvas: &Canvas,
-    ) -> Result<(), String> {
+    fn draw<DB: DrawingBackend>(&self, root: &Area<DB>, _canvas: &Canvas) -> Result<(), String> {
         let cuts: Vec<CutData> = self
             .incs
             .iter()
@@ -347,27 +331,8 @@ impl Chart for CutsChart<'_> {
             DECADES,
         );
         let area = titled(root, &self.title)?;
-        let mut chart = ChartBuilder::on(&area)
-            .margin(14)
-            .margin_right(28)
-            .x_label_area_size(52)
-            .y_label_area_size(84)
-            .build_cartesian_2d(range.0..range.1, (lo..hi).log_scale())
-            .msg()?;
         let unit = self.incs.first().map(|i| i.unit.axis()).unwrap_or_default();
-        chart
-            .configure_mesh()
-            .x_desc("θ_out in the plane of incidence [°]  (− towards the light, + mirror side)")
-            .y_desc(unit)
-            .x_labels(13)
-            .x_label_formatter(&|x| fmt(*x))
-            .y_label_formatter(&|y| fmt(*y))
-            .axis_desc_style((FONT, LABEL))
-            .label_style((FONT, TICK))
-            .bold_line_style(RGBColor(226, 226, 226))
-            .light_line_style(TRANSPARENT)
-            .draw()
-            .msg()?;
+        let mut chart = cut_axes(&area, range, (lo, hi), &unit)?;
         for (k, (inc, cut)) in self.incs.iter().zip(&cuts).enumerate() {
             let c = colour::series(k);
             chart
@@ -385,17 +350,8 @@ impl Chart for CutsChart<'_> {
                 ))
                 .msg()?
                 .label(incidence_label(inc.theta_in, inc.phi_in))
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2))
-                });
+                .legend(legend_line(c.stroke_width(2)));
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .background_style(WHITE.mix(0.9))
-            .border_style(BLACK)
-            .label_font((FONT, SMALL))
-            .draw()
-            .msg()
+        series_legend(&mut chart).draw().msg()
     }
 }

@@ -11,10 +11,9 @@
 use super::{LABEL, SMALL, TICK, fmt, left, text, titled};
 use crate::colour::{self, GUIDE, MASKED};
 use crate::disk::{self, RADIUS};
-use crate::figure::{Canvas, Chart, OrMsg, Raster};
+use crate::figure::{Area, Canvas, Chart, OrMsg, Raster};
 use crate::prepare::{DataUnit, Incidence};
 use brtf_gonio::Hemisphere;
-use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, VPos};
@@ -83,8 +82,8 @@ impl<'a> MapChart<'a> {
 
     fn draw_disk<DB: DrawingBackend>(
         &self,
-        root: &DrawingArea<DB, Shift>,
-        area: &DrawingArea<DB, Shift>,
+        root: &Area<DB>,
+        area: &Area<DB>,
         hemisphere: Hemisphere,
         canvas: &Canvas,
     ) -> Result<(), String> {
@@ -218,8 +217,8 @@ impl<'a> MapChart<'a> {
 
     fn draw_panel<DB: DrawingBackend>(
         &self,
-        root: &DrawingArea<DB, Shift>,
-        area: &DrawingArea<DB, Shift>,
+        root: &Area<DB>,
+        area: &Area<DB>,
     ) -> Result<(), String> {
         let (bx, by) = area.get_base_pixel();
         let (x, top) = (bx + 24, by + 62);
@@ -271,9 +270,13 @@ impl<'a> MapChart<'a> {
         ))
         .msg()?;
 
-        // Legend.
+        // Legend: a symbol in front of each entry's text.
         let mut y = top + h + 36;
         let step = 24;
+        let entry = |y: i32, label: &str| -> Result<(), String> {
+            root.draw(&Text::new(label.to_string(), (x + 32, y), left(SMALL)))
+                .msg()
+        };
         let swatch = |c: RGBColor, y: i32| -> Result<(), String> {
             root.draw(&Rectangle::new([(x, y - 7), (x + 22, y + 7)], c.filled()))
                 .msg()?;
@@ -284,29 +287,14 @@ impl<'a> MapChart<'a> {
             .msg()
         };
         swatch(MASKED, y)?;
-        root.draw(&Text::new(
-            "not fitted (masked)".to_string(),
-            (x + 32, y),
-            left(SMALL),
-        ))
-        .msg()?;
+        entry(y, "not fitted (masked)")?;
         y += step;
         swatch(WHITE, y)?;
-        root.draw(&Text::new(
-            "no sample".to_string(),
-            (x + 32, y),
-            left(SMALL),
-        ))
-        .msg()?;
+        entry(y, "no sample")?;
         y += step;
         root.draw(&TriangleMarker::new((x + 11, y), 6, BLACK.filled()))
             .msg()?;
-        root.draw(&Text::new(
-            "light (incident direction)".to_string(),
-            (x + 32, y),
-            left(SMALL),
-        ))
-        .msg()?;
+        entry(y, "light (incident direction)")?;
         y += step;
         root.draw(&Circle::new((x + 11, y), 7, BLACK.stroke_width(2)))
             .msg()?;
@@ -315,37 +303,27 @@ impl<'a> MapChart<'a> {
         } else {
             "mirror direction"
         };
-        root.draw(&Text::new(target.to_string(), (x + 32, y), left(SMALL)))
-            .msg()?;
-        if let Some(mask) = self.inc.beam_mask() {
+        entry(y, target)?;
+        // The selections' outlines, solid and dashed as on the disks.
+        let outlines = [
+            self.inc
+                .beam_mask()
+                .map(|m| (format!("beam mask ({}°)", crate::prepare::num(m)), None)),
+            self.inc
+                .theta_cap()
+                .filter(|c| *c < 90.0)
+                .map(|c| (format!("θ cap ({}°)", crate::prepare::num(c)), Some((6, 4)))),
+        ];
+        for (label, dashes) in outlines.into_iter().flatten() {
             y += step;
-            root.draw(&PathElement::new(
-                vec![(x, y), (x + 22, y)],
-                BLACK.stroke_width(2),
-            ))
+            let ends = vec![(x, y), (x + 22, y)];
+            let style = BLACK.stroke_width(2);
+            match dashes {
+                None => root.draw(&PathElement::new(ends, style)),
+                Some((dash, gap)) => root.draw(&DashedPathElement::new(ends, dash, gap, style)),
+            }
             .msg()?;
-            root.draw(&Text::new(
-                format!("beam mask ({}°)", crate::prepare::num(mask)),
-                (x + 32, y),
-                left(SMALL),
-            ))
-            .msg()?;
-        }
-        if let Some(cap) = self.inc.theta_cap().filter(|c| *c < 90.0) {
-            y += step;
-            root.draw(&DashedPathElement::new(
-                vec![(x, y), (x + 22, y)],
-                6,
-                4,
-                BLACK.stroke_width(2),
-            ))
-            .msg()?;
-            root.draw(&Text::new(
-                format!("θ cap ({}°)", crate::prepare::num(cap)),
-                (x + 32, y),
-                left(SMALL),
-            ))
-            .msg()?;
+            entry(y, &label)?;
         }
 
         // Numbers.
@@ -419,11 +397,7 @@ impl Chart for MapChart<'_> {
         (DISK * self.hemispheres().len() as u32 + PANEL, DISK + 44)
     }
 
-    fn draw<DB: DrawingBackend>(
-        &self,
-        root: &DrawingArea<DB, Shift>,
-        canvas: &Canvas,
-    ) -> Result<(), String> {
+    fn draw<DB: DrawingBackend>(&self, root: &Area<DB>, canvas: &Canvas) -> Result<(), String> {
         let area = titled(root, &self.title)?;
         let hemispheres = self.hemispheres();
         let (w, h) = area.dim_in_pixel();

@@ -8,8 +8,11 @@ pub mod cut;
 pub mod map;
 pub mod theta;
 
-use crate::figure::{FONT, OrMsg};
-use plotters::coord::Shift;
+use crate::figure::{Area, FONT, OrMsg};
+use plotters::chart::{MeshStyle, SeriesLabelStyle};
+use plotters::coord::CoordTranslate;
+use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
+use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
@@ -18,6 +21,142 @@ pub const TITLE: f64 = 22.0;
 pub const LABEL: f64 = 17.0;
 pub const TICK: f64 = 14.0;
 pub const SMALL: f64 = 13.0;
+
+/// Grid lines: light enough not to compete with the data.
+const GRID: RGBColor = RGBColor(226, 226, 226);
+/// Length in pixels of the line sample in front of a legend entry.
+const LEGEND_SAMPLE: i32 = 20;
+
+/// A Cartesian chart over coordinates `X` × `Y`, being drawn.
+pub type CartesianChart<'a, DB, X, Y> = ChartContext<'a, DB, Cartesian2d<X, Y>>;
+
+/// Margins and label areas around the plot of a Cartesian chart, in pixels.
+pub struct Frame {
+    margin: u32,
+    /// Wider than `margin`, so that the last x tick label fits.
+    margin_right: u32,
+    x_label_area: u32,
+    y_label_area: u32,
+}
+
+impl Frame {
+    /// A chart that fills its file.
+    pub const FULL: Frame = Frame {
+        margin: 14,
+        margin_right: 28,
+        x_label_area: 52,
+        y_label_area: 84,
+    };
+    /// One of several panels in a file: tighter, as they sit side by side.
+    pub const PANEL: Frame = Frame {
+        margin: 12,
+        margin_right: 24,
+        x_label_area: 46,
+        y_label_area: 76,
+    };
+
+    /// A Cartesian chart over `x` × `y` in `area`, within this frame.
+    pub fn chart<'a, DB: DrawingBackend, X: AsRangedCoord, Y: AsRangedCoord>(
+        &self,
+        area: &'a Area<DB>,
+        x: X,
+        y: Y,
+    ) -> Result<CartesianChart<'a, DB, X::CoordDescType, Y::CoordDescType>, String> {
+        ChartBuilder::on(area)
+            .margin(self.margin)
+            .margin_right(self.margin_right)
+            .x_label_area_size(self.x_label_area)
+            .y_label_area_size(self.y_label_area)
+            .build_cartesian_2d(x, y)
+            .msg()
+    }
+}
+
+/// [`fmt`] as a tick formatter.
+fn tick(v: &f64) -> String {
+    fmt(*v)
+}
+
+/// The mesh of `chart` in the shared style: the axis titles, ticks labelled
+/// by [`fmt`], and a grid at the labelled ticks only. The caller adds what
+/// is particular (tick count, a linear axis's formatter) and draws it.
+pub fn mesh<'a, 'b, DB, X, Y>(
+    chart: &'b mut CartesianChart<'a, DB, X, Y>,
+    x_desc: &str,
+    y_desc: &str,
+) -> MeshStyle<'a, 'b, X, Y, DB>
+where
+    DB: DrawingBackend,
+    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    let mut mesh = chart.configure_mesh();
+    mesh.x_desc(x_desc)
+        .y_desc(y_desc)
+        .x_label_formatter(&tick)
+        .y_label_formatter(&tick)
+        .axis_desc_style((FONT, LABEL))
+        .label_style((FONT, TICK))
+        .bold_line_style(GRID)
+        .light_line_style(TRANSPARENT);
+    mesh
+}
+
+/// The legend of `chart`'s labelled series: upper left, framed, on white
+/// that lets the data show through a little. The caller may move or
+/// restyle it, then draws it.
+pub fn series_legend<'a, 'b, DB, CT>(
+    chart: &'b mut ChartContext<'a, DB, CT>,
+) -> SeriesLabelStyle<'a, 'b, DB, CT>
+where
+    DB: DrawingBackend + 'a,
+    CT: CoordTranslate,
+{
+    let mut legend = chart.configure_series_labels();
+    legend
+        .position(SeriesLabelPosition::UpperLeft)
+        .background_style(WHITE.mix(0.9))
+        .border_style(BLACK)
+        .label_font((FONT, SMALL));
+    legend
+}
+
+/// A legend entry's symbol for a line series: a short line in `style`.
+pub fn legend_line(style: ShapeStyle) -> impl Fn((i32, i32)) -> PathElement<(i32, i32)> {
+    move |(x, y)| PathElement::new(vec![(x, y), (x + LEGEND_SAMPLE, y)], style)
+}
+
+/// A legend entry's symbol for a dashed line series (6-pixel dashes, 4
+/// apart, as the series).
+pub fn legend_dashes(
+    style: ShapeStyle,
+) -> impl Fn((i32, i32)) -> DashedPathElement<std::vec::IntoIter<(i32, i32)>, u32> {
+    move |(x, y)| DashedPathElement::new(vec![(x, y), (x + LEGEND_SAMPLE, y)], 6, 4, style)
+}
+
+/// A legend entry's symbol for shaded ranges: a swatch as long as a line
+/// sample.
+pub fn legend_swatch(style: ShapeStyle) -> impl Fn((i32, i32)) -> Rectangle<(i32, i32)> {
+    move |(x, y)| Rectangle::new([(x, y - 6), (x + LEGEND_SAMPLE, y + 6)], style)
+}
+
+/// A legend entry's symbol for circle markers of `radius` pixels, centred
+/// where a line sample would be.
+pub fn legend_circle(
+    radius: i32,
+    style: ShapeStyle,
+) -> impl Fn((i32, i32)) -> Circle<(i32, i32), i32> {
+    move |(x, y)| Circle::new((x + LEGEND_SAMPLE / 2, y), radius, style)
+}
+
+/// A legend entry's symbol for triangle markers of `size` pixels, centred
+/// where a line sample would be.
+pub fn legend_triangle(
+    size: i32,
+    style: ShapeStyle,
+) -> impl Fn((i32, i32)) -> TriangleMarker<(i32, i32), i32> {
+    move |(x, y)| TriangleMarker::new((x + LEGEND_SAMPLE / 2, y), size, style)
+}
 
 /// A text style of `size` pixels in `colour`, anchored at `h`, `v`.
 pub fn text(size: f64, colour: &RGBColor, h: HPos, v: VPos) -> TextStyle<'static> {
@@ -30,10 +169,7 @@ pub fn left(size: f64) -> TextStyle<'static> {
 }
 
 /// Draws the chart's title centred at the top and returns the area below.
-pub fn titled<DB: DrawingBackend>(
-    root: &DrawingArea<DB, Shift>,
-    title: &str,
-) -> Result<DrawingArea<DB, Shift>, String> {
+pub fn titled<DB: DrawingBackend>(root: &Area<DB>, title: &str) -> Result<Area<DB>, String> {
     root.titled(title, (FONT, TITLE).into_font().color(&BLACK))
         .msg()
 }

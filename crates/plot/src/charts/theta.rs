@@ -11,14 +11,17 @@
 //! integral over the hemisphere (brtf-model's [`brtf_model::albedo`]) is
 //! what a renderer will reflect. τ_dh is the same over the back hemisphere.
 
-use super::{LABEL, SMALL, TICK, fmt, lin_fmt, lin_range, theta_range, titled};
+use super::{
+    CartesianChart, Frame, TICK, legend_circle, legend_dashes, legend_line, legend_triangle,
+    lin_fmt, lin_range, mesh, series_legend, theta_range, titled,
+};
 use crate::colour::{ALERT, DATA, GUIDE, MODEL};
-use crate::figure::{Canvas, Chart, FONT, OrMsg};
+use crate::figure::{Area, Canvas, Chart, OrMsg};
 use crate::prepare::{DataUnit, Incidence};
 use brtf_fit::{FitReport, FitResult, Interpolation};
 use brtf_gonio::Hemisphere;
 use brtf_model::{Bsdf, Material};
-use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use std::sync::OnceLock;
@@ -27,6 +30,26 @@ use std::sync::OnceLock;
 const CURVE_STEPS: usize = 60;
 /// Absolute tolerance of the model's hemispherical integrals.
 const ALBEDO_TOLERANCE: f64 = 1e-5;
+
+/// A chart over θ_in with a linear y axis.
+type ThetaAxes<'a, DB> = CartesianChart<'a, DB, RangedCoordf64, RangedCoordf64>;
+
+/// The axes of a chart over θ_in in `area`, drawn: `x` the θ_in range,
+/// `y` the linear value range titled `y_desc`.
+fn theta_axes<'a, DB: DrawingBackend>(
+    area: &'a Area<DB>,
+    frame: &Frame,
+    x: (f64, f64),
+    y: (f64, f64),
+    y_desc: &str,
+) -> Result<ThetaAxes<'a, DB>, String> {
+    let mut chart = frame.chart(area, x.0..x.1, y.0..y.1)?;
+    mesh(&mut chart, "θ_in [°]", y_desc)
+        .y_label_formatter(&lin_fmt(y.0, y.1))
+        .draw()
+        .msg()?;
+    Ok(chart)
+}
 
 /// Model ρ_dh and τ_dh (non-delta + delta parts) of `material` for light
 /// from (θ, φ), channel mean over `channels`, times `scale`.
@@ -200,7 +223,7 @@ impl ParamsChart<'_> {
     /// Draws one panel; true when a parameter ended at a bound.
     fn draw_panel<DB: DrawingBackend>(
         &self,
-        area: &DrawingArea<DB, Shift>,
+        area: &Area<DB>,
         panel: &Panel,
     ) -> Result<bool, String> {
         let result = self.result;
@@ -242,26 +265,13 @@ impl ParamsChart<'_> {
             }
             ys.extend(curve(name).unwrap_or_default().into_iter().map(|p| p.1));
         }
-        let (y0, y1) = lin_range(ys.into_iter());
-        let mut chart = ChartBuilder::on(area)
-            .margin(12)
-            .margin_right(24)
-            .x_label_area_size(46)
-            .y_label_area_size(76)
-            .build_cartesian_2d(x0..x1, y0..y1)
-            .msg()?;
-        chart
-            .configure_mesh()
-            .x_desc("θ_in [°]")
-            .y_desc(panel.y_desc.as_str())
-            .x_label_formatter(&|x| fmt(*x))
-            .y_label_formatter(&lin_fmt(y0, y1))
-            .axis_desc_style((FONT, LABEL))
-            .label_style((FONT, TICK))
-            .bold_line_style(RGBColor(226, 226, 226))
-            .light_line_style(TRANSPARENT)
-            .draw()
-            .msg()?;
+        let mut chart = theta_axes(
+            area,
+            &Frame::PANEL,
+            (x0, x1),
+            lin_range(ys.into_iter()),
+            &panel.y_desc,
+        )?;
         let cap = 0.008 * (x1 - x0);
         let mut any_bound = false;
         for (label, name, colour) in &panel.series {
@@ -313,7 +323,7 @@ impl ParamsChart<'_> {
                 .msg()?;
             if panel.series.len() > 1 {
                 anno.label(label.as_str())
-                    .legend(move |(x, y)| Circle::new((x + 10, y), 4, colour.filled()));
+                    .legend(legend_circle(4, colour.filled()));
             }
             let bound: Vec<_> = points.iter().filter(|(_, p)| p.at_bound).collect();
             if !bound.is_empty() {
@@ -328,12 +338,10 @@ impl ParamsChart<'_> {
             }
         }
         if panel.series.len() > 1 {
-            chart
-                .configure_series_labels()
-                .position(SeriesLabelPosition::UpperLeft)
+            // Lighter than a whole chart's legend, as it sits inside a small panel.
+            series_legend(&mut chart)
                 .background_style(WHITE.mix(0.85))
                 .border_style(GUIDE)
-                .label_font((FONT, SMALL))
                 .draw()
                 .msg()?;
         }
@@ -343,8 +351,8 @@ impl ParamsChart<'_> {
     /// The legend shared by every panel, drawn in the strip `area`.
     fn draw_legend<DB: DrawingBackend>(
         &self,
-        root: &DrawingArea<DB, Shift>,
-        area: &DrawingArea<DB, Shift>,
+        root: &Area<DB>,
+        area: &Area<DB>,
         any_bound: bool,
     ) -> Result<(), String> {
         let (bx, by) = area.get_base_pixel();
@@ -411,11 +419,7 @@ impl Chart for ParamsChart<'_> {
         (if cols == 1 { 900 } else { 1300 }, 84 + 420 * rows as u32)
     }
 
-    fn draw<DB: DrawingBackend>(
-        &self,
-        root: &DrawingArea<DB, Shift>,
-        _canvas: &Canvas,
-    ) -> Result<(), String> {
+    fn draw<DB: DrawingBackend>(&self, root: &Area<DB>, _canvas: &Canvas) -> Result<(), String> {
         let area = titled(root, &self.title)?;
         let (strip, body) = area.split_vertically(34);
         let panels = self.panels();
@@ -510,15 +514,7 @@ impl Chart for RhoChart<'_> {
         "rho".into()
     }
 
-    fn size(&self) -> (u32, u32) {
-        (1000, 640)
-    }
-
-    fn draw<DB: DrawingBackend>(
-        &self,
-        root: &DrawingArea<DB, Shift>,
-        _canvas: &Canvas,
-    ) -> Result<(), String> {
+    fn draw<DB: DrawingBackend>(&self, root: &Area<DB>, _canvas: &Canvas) -> Result<(), String> {
         let ints = self
             .integrals
             .get_or_init(|| integrals(self.result, &self.incs));
@@ -546,31 +542,19 @@ impl Chart for RhoChart<'_> {
             .fold(0.0, f64::max);
         let thetas: Vec<f64> = ints.iter().map(|i| i.theta).collect();
         let (x0, x1) = theta_range(&thetas);
-        let area = titled(root, &self.title)?;
-        let mut chart = ChartBuilder::on(&area)
-            .margin(14)
-            .margin_right(28)
-            .x_label_area_size(52)
-            .y_label_area_size(84)
-            .build_cartesian_2d(x0..x1, 0.0..(top * 1.25).max(1e-12))
-            .msg()?;
         let y_desc = if back {
             self.unit.integral_axis().replace("ρ_dh", "ρ_dh, τ_dh")
         } else {
             self.unit.integral_axis()
         };
-        chart
-            .configure_mesh()
-            .x_desc("θ_in [°]")
-            .y_desc(y_desc)
-            .x_label_formatter(&|x| fmt(*x))
-            .y_label_formatter(&lin_fmt(0.0, top * 1.25))
-            .axis_desc_style((FONT, LABEL))
-            .label_style((FONT, TICK))
-            .bold_line_style(RGBColor(226, 226, 226))
-            .light_line_style(TRANSPARENT)
-            .draw()
-            .msg()?;
+        let area = titled(root, &self.title)?;
+        let mut chart = theta_axes(
+            &area,
+            &Frame::FULL,
+            (x0, x1),
+            (0.0, (top * 1.25).max(1e-12)),
+            &y_desc,
+        )?;
         for &h in hemis {
             let (sym, data_c, model_c) = if h == 0 {
                 ("ρ", DATA, MODEL)
@@ -588,12 +572,7 @@ impl Chart for RhoChart<'_> {
                     .label(format!(
                         "{sym} model, interpolated material, whole hemisphere"
                     ))
-                    .legend(move |(x, y)| {
-                        PathElement::new(
-                            vec![(x, y), (x + 20, y)],
-                            model_c.mix(0.7).stroke_width(2),
-                        )
-                    });
+                    .legend(legend_line(model_c.mix(0.7).stroke_width(2)));
             }
             let global: Vec<(f64, f64)> = curves
                 .iter()
@@ -604,14 +583,7 @@ impl Chart for RhoChart<'_> {
                     .draw_series(DashedLineSeries::new(global, 6, 4, GUIDE.stroke_width(2)))
                     .msg()?
                     .label(format!("{sym} model, all-incidence fit, whole hemisphere"))
-                    .legend(|(x, y)| {
-                        DashedPathElement::new(
-                            vec![(x, y), (x + 20, y)],
-                            6,
-                            4,
-                            GUIDE.stroke_width(2),
-                        )
-                    });
+                    .legend(legend_dashes(GUIDE.stroke_width(2)));
             }
             chart
                 .draw_series(
@@ -623,7 +595,7 @@ impl Chart for RhoChart<'_> {
                 )
                 .msg()?
                 .label(format!("{sym} model, per-incidence fit, whole hemisphere"))
-                .legend(move |(x, y)| Circle::new((x + 10, y), 6, model_c.stroke_width(2)));
+                .legend(legend_circle(6, model_c.stroke_width(2)));
             let data: Vec<(f64, f64)> = ints
                 .iter()
                 .filter_map(|i| i.data[h].map(|v| (i.theta, v)))
@@ -637,7 +609,7 @@ impl Chart for RhoChart<'_> {
                 .label(format!(
                     "{sym} data, ∫ over the directions of the fitted samples"
                 ))
-                .legend(move |(x, y)| Circle::new((x + 10, y), 4, data_c.filled()));
+                .legend(legend_circle(4, data_c.filled()));
             let same: Vec<(f64, f64)> = ints
                 .iter()
                 .filter_map(|i| i.model_same[h].map(|v| (i.theta, v)))
@@ -649,14 +621,11 @@ impl Chart for RhoChart<'_> {
                 )
                 .msg()?
                 .label(format!("{sym} model, same directions"))
-                .legend(move |(x, y)| TriangleMarker::new((x + 10, y), 8, model_c.stroke_width(2)));
+                .legend(legend_triangle(8, model_c.stroke_width(2)));
         }
-        chart
-            .configure_series_labels()
+        // Lower left: the axis starts at 0, well below the reflectances.
+        series_legend(&mut chart)
             .position(SeriesLabelPosition::LowerLeft)
-            .background_style(WHITE.mix(0.9))
-            .border_style(BLACK)
-            .label_font((FONT, SMALL))
             .draw()
             .msg()
     }
@@ -681,11 +650,7 @@ impl Chart for RmsChart<'_> {
         (1000, 560)
     }
 
-    fn draw<DB: DrawingBackend>(
-        &self,
-        root: &DrawingArea<DB, Shift>,
-        _canvas: &Canvas,
-    ) -> Result<(), String> {
+    fn draw<DB: DrawingBackend>(&self, root: &Area<DB>, _canvas: &Canvas) -> Result<(), String> {
         let result = self.result;
         let rms: Vec<(f64, f64)> = result
             .incidences
@@ -708,25 +673,13 @@ impl Chart for RmsChart<'_> {
         let thetas: Vec<f64> = rms.iter().map(|p| p.0).collect();
         let (x0, x1) = theta_range(&thetas);
         let area = titled(root, &self.title)?;
-        let mut chart = ChartBuilder::on(&area)
-            .margin(14)
-            .margin_right(28)
-            .x_label_area_size(52)
-            .y_label_area_size(84)
-            .build_cartesian_2d(x0..x1, 0.0..(top * 1.3).max(1e-6))
-            .msg()?;
-        chart
-            .configure_mesh()
-            .x_desc("θ_in [°]")
-            .y_desc("relative error [–]")
-            .x_label_formatter(&|x| fmt(*x))
-            .y_label_formatter(&lin_fmt(0.0, top * 1.3))
-            .axis_desc_style((FONT, LABEL))
-            .label_style((FONT, TICK))
-            .bold_line_style(RGBColor(226, 226, 226))
-            .light_line_style(TRANSPARENT)
-            .draw()
-            .msg()?;
+        let mut chart = theta_axes(
+            &area,
+            &Frame::FULL,
+            (x0, x1),
+            (0.0, (top * 1.3).max(1e-6)),
+            "relative error [–]",
+        )?;
         if let Some(g) = &result.global {
             chart
                 .draw_series(DashedLineSeries::new(
@@ -737,9 +690,7 @@ impl Chart for RmsChart<'_> {
                 ))
                 .msg()?
                 .label("RMS relative error, all-incidence fit")
-                .legend(|(x, y)| {
-                    DashedPathElement::new(vec![(x, y), (x + 20, y)], 6, 4, GUIDE.stroke_width(2))
-                });
+                .legend(legend_dashes(GUIDE.stroke_width(2)));
         }
         chart
             .draw_series(LineSeries::new(rms.clone(), MODEL.stroke_width(1)))
@@ -748,7 +699,7 @@ impl Chart for RmsChart<'_> {
             .draw_series(rms.iter().map(|&p| Circle::new(p, 5, MODEL.filled())))
             .msg()?
             .label("RMS of (model − data) ÷ √(data² + floor²), per incidence")
-            .legend(|(x, y)| Circle::new((x + 10, y), 5, MODEL.filled()));
+            .legend(legend_circle(5, MODEL.filled()));
         if !medians.is_empty() {
             chart
                 .draw_series(LineSeries::new(medians.clone(), DATA.stroke_width(1)))
@@ -761,15 +712,8 @@ impl Chart for RmsChart<'_> {
                 )
                 .msg()?
                 .label("median |model ÷ data − 1| over the fitted samples")
-                .legend(|(x, y)| TriangleMarker::new((x + 10, y), 6, DATA.filled()));
+                .legend(legend_triangle(6, DATA.filled()));
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .background_style(WHITE.mix(0.9))
-            .border_style(BLACK)
-            .label_font((FONT, SMALL))
-            .draw()
-            .msg()
+        series_legend(&mut chart).draw().msg()
     }
 }
