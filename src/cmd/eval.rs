@@ -1,10 +1,11 @@
 //! `brtf eval`: BSDF values for directions read as CSV on stdin.
 
 use super::material::MaterialArgs;
+use super::shared::{csv_stdout, write_numbers};
 use anyhow::{Context, Result, bail};
 use brtf_model::direction;
 use clap::Args;
-use std::io::{BufRead, BufWriter, Write};
+use std::io::BufRead;
 
 #[derive(Args, Debug)]
 pub struct EvalArgs {
@@ -22,9 +23,8 @@ pub fn run(args: EvalArgs) -> Result<()> {
     let bsdf = args.material.bsdf()?;
     let l = direction(args.theta_in, args.phi_in);
     let stdin = std::io::stdin();
-    let stdout = std::io::stdout();
-    let mut out = BufWriter::new(stdout.lock());
-    writeln!(out, "theta_out,phi_out,r,g,b")?;
+    let mut out = csv_stdout();
+    out.write_record(["theta_out", "phi_out", "r", "g", "b"])?;
     for (index, line) in stdin.lock().lines().enumerate() {
         let number = index + 1;
         let line = line.with_context(|| format!("<stdin>:{number}: cannot read"))?;
@@ -49,7 +49,7 @@ pub fn run(args: EvalArgs) -> Result<()> {
             ),
         };
         let f = bsdf.eval(l, direction(theta, phi));
-        writeln!(out, "{},{},{},{},{}", theta, phi, f[0], f[1], f[2])?;
+        write_numbers(&mut out, &[theta, phi, f[0], f[1], f[2]])?;
     }
     out.flush()?;
     Ok(())

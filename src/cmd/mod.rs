@@ -9,4 +9,5 @@ pub mod material;
 pub mod output;
 pub mod plot;
 pub mod render;
+pub mod shared;
 pub mod synth;

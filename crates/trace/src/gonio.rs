@@ -66,6 +66,123 @@ impl GonioSetup {
     pub fn light(&self) -> DVec3 {
         brtf_model::direction(self.theta_in, self.phi_in)
     }
+
+    /// Checks the incidence (θ_in in [0, 180]°, φ_in finite) and the
+    /// apertures (finite, ≥ 0 sr).
+    pub fn validate(&self) -> Result<(), GonioError> {
+        if !(self.theta_in.is_finite()
+            && (0.0..=180.0).contains(&self.theta_in)
+            && self.phi_in.is_finite())
+        {
+            return Err(GonioError::Incidence {
+                theta_in: self.theta_in,
+                phi_in: self.phi_in,
+            });
+        }
+        for (aperture, omega) in [
+            (Aperture::Source, self.source_omega),
+            (Aperture::Detector, self.detector_omega),
+        ] {
+            if !(omega.is_finite() && omega >= 0.0) {
+                return Err(GonioError::Omega(aperture));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The two apertures of the instrument.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Aperture {
+    /// The beam.
+    Source,
+    /// The detector.
+    Detector,
+}
+
+impl std::fmt::Display for Aperture {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Aperture::Source => "source",
+            Aperture::Detector => "detector",
+        })
+    }
+}
+
+/// A gonio-photometer number that cannot make a measurement. The
+/// messages name the `brtf render gonio` options the numbers come from.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum GonioError {
+    #[error("θ_in must be between 0 and 180 degrees")]
+    Incidence { theta_in: f64, phi_in: f64 },
+    #[error("give the {0} as --{0}-omega or --{0}-apex, not both")]
+    OmegaAndApex(Aperture),
+    #[error("--{0}-omega must be ≥ 0 sr")]
+    Omega(Aperture),
+    #[error("--{0}-apex must be between 0 and 180 degrees")]
+    Apex(Aperture),
+    #[error("grid steps must be positive")]
+    GridStep { theta_step: f64, phi_step: f64 },
+    #[error("grid steps too small: {directions} directions (at most {MAX_GRID_DIRECTIONS})")]
+    GridSize { directions: f64 },
+}
+
+/// An aperture's solid angle in sr, given either as a solid angle `omega`
+/// (sr) or as a full cone apex angle `apex` (degrees), or neither (`None`).
+pub fn aperture_solid_angle(
+    aperture: Aperture,
+    omega: Option<f64>,
+    apex: Option<f64>,
+) -> Result<Option<f64>, GonioError> {
+    match (omega, apex) {
+        (Some(_), Some(_)) => Err(GonioError::OmegaAndApex(aperture)),
+        (Some(w), None) if w.is_finite() && w >= 0.0 => Ok(Some(w)),
+        (Some(_), None) => Err(GonioError::Omega(aperture)),
+        (None, Some(a)) if a.is_finite() && (0.0..=180.0).contains(&a) => {
+            Ok(Some(brtf_model::cone_solid_angle(a)))
+        }
+        (None, Some(_)) => Err(GonioError::Apex(aperture)),
+        (None, None) => Ok(None),
+    }
+}
+
+/// The most directions [`grid`] returns.
+pub const MAX_GRID_DIRECTIONS: usize = 10_000_000;
+
+/// A direction grid (θ_out, φ_out in degrees): θ_out from 0 to 85° (and
+/// 180 − θ_out, the back hemisphere, with `back`) in `theta_step` steps,
+/// φ_out over 360° in about `phi_step` steps (one φ_out at θ_out = 0).
+pub fn grid(theta_step: f64, phi_step: f64, back: bool) -> Result<Vec<(f64, f64)>, GonioError> {
+    let (dt, dp) = (theta_step, phi_step);
+    if !(dt > 0.0 && dp > 0.0 && dt.is_finite() && dp.is_finite()) {
+        return Err(GonioError::GridStep {
+            theta_step,
+            phi_step,
+        });
+    }
+    let n_theta_f = (85.0 / dt).floor();
+    let n_phi_f = (360.0 / dp).round().max(1.0);
+    let directions = (n_theta_f * n_phi_f + 1.0) * if back { 2.0 } else { 1.0 };
+    if directions > MAX_GRID_DIRECTIONS as f64 {
+        return Err(GonioError::GridSize { directions });
+    }
+    let mut dirs = Vec::new();
+    let n_theta = n_theta_f as usize;
+    let n_phi = ((360.0 / dp).round() as usize).max(1);
+    for i in 0..=n_theta {
+        let t = i as f64 * dt;
+        for j in 0..n_phi {
+            let p = j as f64 * 360.0 / n_phi as f64;
+            dirs.push((t, p));
+            if back {
+                dirs.push((180.0 - t, p));
+            }
+            if i == 0 {
+                break;
+            }
+        }
+    }
+    Ok(dirs)
 }
 
 /// One rendered reading.

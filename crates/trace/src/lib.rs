@@ -11,7 +11,9 @@
 //!   sample as a [`brtf_gonio::Measurement`];
 //! * **pictures** ([`image`]): the material on a sphere and a plane under a
 //!   source, through a pinhole camera with Radiance's view parameters,
-//!   written as Radiance HDR ([`hdr`]) and tone-mapped PNG.
+//!   written as Radiance HDR ([`hdr`]) and tone-mapped PNG; the picture
+//!   scene of `brtf render image` is a [`SceneSpec`] ([`scene_spec`]),
+//!   which also writes itself as Radiance text for `rpict`.
 //!
 //! ## Equation (1), as traced here
 //!
@@ -40,15 +42,17 @@ pub mod gonio;
 pub mod hdr;
 pub mod image;
 pub mod integrator;
-pub mod rng;
+pub use brtf_model::rng;
 pub mod sampling;
 pub mod scene;
+pub mod scene_spec;
 pub mod shader;
 
 pub use camera::Camera;
-pub use gonio::{GonioSetup, GonioValue, VirtualGonio, cone_average};
+pub use gonio::{GonioError, GonioSetup, GonioValue, VirtualGonio, cone_average};
 pub use image::{ImageOptions, Rendered, render};
 pub use integrator::{RayCounts, Settings, Tracer};
 pub use rng::Rng;
 pub use scene::{Ray, Scene, Shape, Source};
+pub use scene_spec::{LightKind, LightSpec, SceneKind, SceneSpec, SceneSpecError, ViewSpec};
 pub use shader::{Shader, ShaderError};

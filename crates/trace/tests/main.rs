@@ -8,10 +8,13 @@
 //!   cone average (finite apertures).
 //! * `furnace`: white furnace: rendered radiance = ρ_dh·L.
 //! * `image`: determinism, HDR/PNG output, sphere lights.
+//! * `scene_spec`: the picture scene of `brtf render image` (validation,
+//!   Radiance text) and the gonio-photometer's grid and apertures.
 
 mod common;
 mod furnace;
 mod gonio;
 mod image;
 mod sampling;
+mod scene_spec;
 mod shader;
