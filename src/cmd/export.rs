@@ -31,10 +31,7 @@ pub struct ExportArgs {
 
 pub fn run(args: ExportArgs) -> Result<()> {
     let fit_path = args.dir.join("fit.json");
-    let text = std::fs::read_to_string(&fit_path)
-        .with_context(|| format!("cannot read {}", fit_path.display()))?;
-    let result: FitResult = serde_json::from_str(&text)
-        .with_context(|| format!("{} is not a brtf fit result", fit_path.display()))?;
+    let result = FitResult::read(&fit_path)?;
     let out = args.out.unwrap_or_else(|| args.dir.clone());
     std::fs::create_dir_all(&out)
         .with_context(|| format!("cannot create the folder {}", out.display()))?;

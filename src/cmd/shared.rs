@@ -5,13 +5,9 @@ use anyhow::{Context, Result};
 use brtf_fit::FitResult;
 use std::path::Path;
 
-/// Reads `DIR/fit.json`.
+/// Reads `DIR/fit.json` (see [`FitResult::read`]).
 pub fn read_fit(dir: &Path) -> Result<FitResult> {
-    let path = dir.join("fit.json");
-    let text = std::fs::read_to_string(&path)
-        .with_context(|| format!("cannot read {}", path.display()))?;
-    serde_json::from_str(&text)
-        .with_context(|| format!("{}: not a brtf fit result", path.display()))
+    Ok(FitResult::read(&dir.join("fit.json"))?)
 }
 
 /// Runs `f` on a rayon pool of `jobs` threads (or the global pool).

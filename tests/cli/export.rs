@@ -137,6 +137,7 @@ fn result_of(
         ParamTable::from_reports(config.kind, config.orientation, &incidences, method).unwrap()
     });
     FitResult {
+        schema: brtf_fit::FIT_JSON_SCHEMA,
         name: name.into(),
         provenance: Provenance {
             brtf_version: "0.1.0".into(),
@@ -149,17 +150,18 @@ fn result_of(
                     sha256: "0".repeat(64),
                     theta_in: r.theta_in,
                     phi_in: r.phi_in,
-                    quantity: "BSDF".into(),
+                    conversion: brtf_fit::Conversion::Bsdf,
                     samples: 2000,
                 })
                 .collect(),
         },
+        recipe: brtf_fit::Recipe::for_kind(config.kind),
         config,
-        selections: vec!["theta_out <= 85°".into()],
         incidences,
         global,
         table,
         interpolation: method,
+        warnings: Vec::new(),
     }
 }
 
@@ -567,6 +569,9 @@ fn bad_input_fails_with_a_message() {
     let err = brtf(&["export", s(tmp.path())], "").err();
     assert!(err.contains("fit.json"), "{err}");
     std::fs::write(tmp.path().join("fit.json"), "{\"name\": 3}").unwrap();
+    let err = brtf(&["export", s(tmp.path())], "").err();
+    assert!(err.contains("schema version 1"), "{err}");
+    std::fs::write(tmp.path().join("fit.json"), "{\"schema\": 2, \"name\": 3}").unwrap();
     let err = brtf(&["export", s(tmp.path())], "").err();
     assert!(err.contains("not a brtf fit result"), "{err}");
 

@@ -320,7 +320,7 @@ fn real_pgii_scans_fit_with_a_free_scale() {
         assert!(spec > 0.0 && spec <= 1.0, "{file}: spec {spec}");
         assert!(rough > 0.01 && rough < 0.5, "{file}: rough {rough}");
         assert!(r.value("scale").unwrap() > 0.0);
-        assert!(result.provenance.inputs[0].quantity.contains("free scale"));
+        assert!(result.provenance.inputs[0].conversion.is_free_scale());
         eprintln!(
             "{file} as {model}: spec {spec:.4} rough {rough:.4} scale {:.5} rms_rel {:.3}",
             r.scale, r.rms_rel
@@ -348,11 +348,21 @@ fn a_known_reflectance_makes_a_raw_fit_absolute() {
         r.params.iter().all(|p| p.name != "scale"),
         "no free scale after --rho"
     );
-    assert!(
-        result.provenance.inputs[0]
-            .quantity
-            .contains("from --rho 0.8@26.8421")
-    );
+    assert!(matches!(
+        result.provenance.inputs[0].conversion,
+        brtf_fit::Conversion::Raw {
+            scale: brtf_fit::RawScale::KnownReflectance {
+                rho: 0.8,
+                theta_in: 26.8421,
+                ..
+            },
+            ..
+        }
+    ));
+    assert!(matches!(
+        result.recipe.scale,
+        brtf_fit::ScaleRule::KnownReflectance { rho: 0.8, .. }
+    ));
     // The fitted material's own ρ_dh at that incidence is the given 0.8.
     let material = write_file(
         dir.path(),
@@ -535,7 +545,7 @@ fn robust_standard_errors_hold_for_the_default_absolute_residuals() {
             assert!(result.incidences.iter().all(|r| {
                 r.warnings
                     .iter()
-                    .any(|w| w.contains("standard errors understate"))
+                    .any(|w| matches!(w, brtf_fit::FitWarning::UnderstatedErrors { .. }))
             }));
         }
     }

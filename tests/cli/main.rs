@@ -10,6 +10,7 @@
 
 mod albedo;
 mod common;
+mod contract;
 mod eval;
 mod export;
 mod fit;

@@ -216,8 +216,8 @@ impl Reported<'_> {
             .physical(&u)
             .ok_or_else(|| failed("the solution is not a valid material"))?;
         // The solution's pass from the optimiser's own history.
-        let final_pass =
-            at_solution.ok_or_else(|| failed("non-finite residuals or Jacobian at the solution"))?;
+        let final_pass = at_solution
+            .ok_or_else(|| failed("non-finite residuals or Jacobian at the solution"))?;
         let errors = standard_errors(&final_pass, cost, problem.n_residuals(), map.len());
         let physical_error = |i: usize| {
             (

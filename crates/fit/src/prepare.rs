@@ -3,8 +3,8 @@
 //! bandwidth): the data checks, the fitter's [`Block`], and the statistics
 //! behind the automatic floor and the starting values.
 
-use crate::data::{FitSample, IncidenceData};
 use crate::config::{FitConfig, FitError};
+use crate::data::{FitSample, IncidenceData};
 use crate::params::{MIN_ROUGHNESS, ParamMap, Target};
 use crate::problem::Block;
 use glam::DVec3;

@@ -74,6 +74,33 @@ pub struct Recipe {
     pub weights: WeightRule,
 }
 
+impl Recipe {
+    /// `brtf fit`'s defaults for a model: scale from the files, channels
+    /// as recorded, solid-angle weights; drop unavailable values, keep the
+    /// front hemisphere (both for transmitting models), θ_out ≤ 85° and a
+    /// 3° beam mask.
+    pub fn for_kind(kind: brtf_model::MaterialKind) -> Recipe {
+        let mut selections = vec![Gate::Unavailable];
+        if !kind.is_transmitting() {
+            selections.push(Gate::Hemisphere {
+                keep: brtf_gonio::Hemisphere::Front,
+            });
+        }
+        selections.push(Gate::ThetaCap {
+            max_deg: brtf_gonio::DEFAULT_THETA_CAP_DEG,
+        });
+        selections.push(Gate::BeamMask {
+            half_angle_deg: 3.0,
+        });
+        Recipe {
+            scale: ScaleRule::FromFiles,
+            colour: ColourConversion::AsRecorded,
+            selections,
+            weights: WeightRule::SolidAngle,
+        }
+    }
+}
+
 /// Where a beam integral came from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -165,7 +192,10 @@ impl std::fmt::Display for Conversion {
                     "raw [{unit}] ÷ |cos θ_out| ÷ K = {k:e} from --rho {rho}@{theta_in}"
                 ),
                 RawScale::Free => {
-                    write!(f, "raw [{unit}] ÷ |cos θ_out|, free scale (no beam integral)")
+                    write!(
+                        f,
+                        "raw [{unit}] ÷ |cos θ_out|, free scale (no beam integral)"
+                    )
                 }
             },
         }
@@ -309,10 +339,9 @@ impl Recipe {
                 return match self.scale {
                     ScaleRule::BeamIntegral { .. } => Err(not_raw("--beam-integral")),
                     ScaleRule::KnownReflectance { .. } => Err(not_raw("--rho")),
-                    ScaleRule::FromFiles if *other == Quantity::Dsf => Ok((
-                        m.to_bsdf().map_err(failed)?.measurement,
-                        Conversion::Dsf,
-                    )),
+                    ScaleRule::FromFiles if *other == Quantity::Dsf => {
+                        Ok((m.to_bsdf().map_err(failed)?.measurement, Conversion::Dsf))
+                    }
                     ScaleRule::FromFiles => Ok((m.clone(), Conversion::Bsdf)),
                 };
             }

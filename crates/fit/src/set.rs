@@ -104,7 +104,9 @@ pub fn fit_set(
     inputs.sort_by(|a, b| a.file.theta_in.total_cmp(&b.file.theta_in));
 
     let mut config = options.config.clone();
-    let free = inputs.iter().filter(|i| i.prepared.conversion.is_free_scale());
+    let free = inputs
+        .iter()
+        .filter(|i| i.prepared.conversion.is_free_scale());
     let free_count = free.count();
     if free_count > 0 && free_count < inputs.len() && !config.free_scale {
         return Err(FitSetError::MixedScale);
@@ -242,10 +244,7 @@ fn fit_all(
     config: &FitConfig,
     progress: &dyn Progress,
 ) -> Result<(Vec<FitReport>, FitReport), FitSetError> {
-    let data: Vec<IncidenceData> = inputs
-        .iter()
-        .map(|i| i.prepared.incidence_data())
-        .collect();
+    let data: Vec<IncidenceData> = inputs.iter().map(|i| i.prepared.incidence_data()).collect();
     progress.begin(data.len() as u64 + 1);
     let (reports, global) = rayon::join(
         || {

@@ -61,19 +61,16 @@ pub fn summary(result: &FitResult, out: &Path) -> String {
         line("all".into(), g);
     }
     let _ = writeln!(s, "(! = at a bound, = = held fixed)");
-    let global = result
-        .global
-        .iter()
-        .filter(|_| result.incidences.len() > 1);
+    let global = result.global.iter().filter(|_| result.incidences.len() > 1);
     let labelled = result
         .incidences
         .iter()
         .map(|r| (r, format!("{} (θ_in {})", r.source, r.theta_in)))
         .chain(global.map(|r| (r, "all incidences".to_string())));
-    let mut warnings: Vec<String> = labelled
+    // The set's own warnings go to stderr (the CLI prints them).
+    let warnings: Vec<String> = labelled
         .flat_map(|(r, label)| r.warnings.iter().map(move |w| format!("{label}: {w}")))
         .collect();
-    warnings.extend(result.warnings.iter().map(|w| w.to_string()));
     if !warnings.is_empty() {
         let _ = writeln!(s, "\nwarnings:");
         for w in &warnings {

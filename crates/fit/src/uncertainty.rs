@@ -20,7 +20,12 @@ pub(crate) struct UnconstrainedErrors {
 
 /// The standard errors at the solution `pass`, whose cost is `cost`, over
 /// `m` residuals and `n` parameters.
-pub(crate) fn standard_errors(pass: &Compressed, cost: f64, m: usize, n: usize) -> UnconstrainedErrors {
+pub(crate) fn standard_errors(
+    pass: &Compressed,
+    cost: f64,
+    m: usize,
+    n: usize,
+) -> UnconstrainedErrors {
     let dof = m.saturating_sub(n).max(1) as f64;
     let s2 = 2.0 * cost / dof;
     // JᵀJ = RᵀR for the compressed Jacobian [R; 0].

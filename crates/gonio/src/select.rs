@@ -75,9 +75,7 @@ impl Gate {
         match *self {
             Gate::Unavailable => values.iter().all(|v| v.is_finite()),
             Gate::Hemisphere { keep } => sample.hemisphere() == keep,
-            Gate::ThetaCap { max_deg } => {
-                sample.theta_deg.min(180.0 - sample.theta_deg) <= max_deg
-            }
+            Gate::ThetaCap { max_deg } => sample.theta_deg.min(180.0 - sample.theta_deg) <= max_deg,
             Gate::BeamMask { half_angle_deg } => {
                 sample.direction().dot(context.light) < half_angle_deg.to_radians().cos()
             }

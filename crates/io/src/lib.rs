@@ -145,7 +145,10 @@ mod tests {
     fn unix_times_print_as_rfc3339() {
         assert_eq!(rfc3339_of_unix_seconds(0), "1970-01-01T00:00:00Z");
         assert_eq!(rfc3339_of_unix_seconds(951_782_400), "2000-02-29T00:00:00Z");
-        assert_eq!(rfc3339_of_unix_seconds(1_795_459_335), "2026-11-23T18:42:15Z");
+        assert_eq!(
+            rfc3339_of_unix_seconds(1_795_459_335),
+            "2026-11-23T18:42:15Z"
+        );
     }
 
     use super::*;
@@ -196,6 +199,9 @@ mod tests {
         );
         assert_eq!(locate_input("nowhere/b.mpc", &fit, &[]), None);
         std::fs::write(fit.join("b.mpc"), b"x").unwrap();
-        assert_eq!(locate_input("nowhere/b.mpc", &fit, &[]), Some(fit.join("b.mpc")));
+        assert_eq!(
+            locate_input("nowhere/b.mpc", &fit, &[]),
+            Some(fit.join("b.mpc"))
+        );
     }
 }

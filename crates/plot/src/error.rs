@@ -19,16 +19,9 @@ pub enum PlotError {
         #[source]
         source: std::io::Error,
     },
-    /// `fit.json` is not a valid fit result.
-    #[error("{}:{line}: not a brtf fit result: {message}", .path.display())]
-    FitJson {
-        /// The `fit.json` file.
-        path: PathBuf,
-        /// 1-based line of the problem.
-        line: usize,
-        /// What serde_json found wrong.
-        message: String,
-    },
+    /// `fit.json` could not be read, or is not a fit result of this schema.
+    #[error(transparent)]
+    FitJson(#[from] brtf_fit::ReadFitError),
     /// The fit result has no incidence to plot.
     #[error("the fit result has no incidences to plot")]
     NoIncidences,

@@ -19,10 +19,8 @@ use crate::error::PlotError;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::cell::RefCell;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// The font family every chart uses.
 pub const FONT: &str = "sans-serif";
@@ -254,41 +252,12 @@ pub fn base64(bytes: &[u8]) -> String {
     out
 }
 
-/// Writes `bytes` to `path` through a temporary file in the same folder
-/// and a rename, so a reader never sees half a file.
+/// Writes `bytes` to `path` atomically (see [`brtf_io::write_atomic`]).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), PlotError> {
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    std::fs::create_dir_all(dir).map_err(|source| PlotError::Io {
-        path: dir.to_path_buf(),
-        what: "cannot create folder",
-        source,
-    })?;
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    static COUNTER: AtomicUsize = AtomicUsize::new(0);
-    let tmp = dir.join(format!(
-        ".{name}.{}.{}.tmp",
-        std::process::id(),
-        COUNTER.fetch_add(1, Ordering::Relaxed)
-    ));
-    let result = (|| -> std::io::Result<()> {
-        let mut file = std::fs::File::create(&tmp)?;
-        file.write_all(bytes)?;
-        file.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result.map_err(|source| PlotError::Io {
-        path: path.to_path_buf(),
-        what: "cannot write",
-        source,
+    brtf_io::write_atomic(path, bytes).map_err(|e| PlotError::Io {
+        path: e.path,
+        what: e.what,
+        source: e.source,
     })
 }
 

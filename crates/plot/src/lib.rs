@@ -87,19 +87,9 @@ pub struct Written {
     pub warnings: Vec<String>,
 }
 
-/// Reads `<dir>/fit.json`.
+/// Reads `<dir>/fit.json` (see [`FitResult::read`]).
 pub fn read_fit(dir: &Path) -> Result<FitResult, PlotError> {
-    let path = dir.join("fit.json");
-    let text = std::fs::read_to_string(&path).map_err(|source| PlotError::Io {
-        path: path.clone(),
-        what: "cannot read",
-        source,
-    })?;
-    serde_json::from_str(&text).map_err(|e| PlotError::FitJson {
-        path,
-        line: e.line(),
-        message: e.to_string(),
-    })
+    Ok(FitResult::read(&dir.join("fit.json"))?)
 }
 
 /// The colour-bar ratio for the maps (see [`PlotOptions::ratio`]).

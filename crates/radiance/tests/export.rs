@@ -63,6 +63,7 @@ fn fit(
             .unwrap()
     });
     FitResult {
+        schema: brtf_fit::FIT_JSON_SCHEMA,
         name: name.into(),
         provenance: Provenance {
             brtf_version: "0.1.0".into(),
@@ -84,13 +85,13 @@ fn fit(
                     sha256: "ab".repeat(32),
                     theta_in: r.theta_in,
                     phi_in: 0.0,
-                    quantity: "BSDF".into(),
+                    conversion: brtf_fit::Conversion::Bsdf,
                     samples: 8100,
                 })
                 .collect(),
         },
+        recipe: brtf_fit::Recipe::for_kind(config.kind),
         config,
-        selections: vec!["θ_out ≤ 85°".into()],
         global: global.map(|a| {
             let mut r = report(kind, 0.0, a);
             r.source = "all incidences".into();
@@ -99,6 +100,7 @@ fn fit(
         incidences,
         table,
         interpolation: Interpolation::Pchip,
+        warnings: Vec::new(),
     }
 }
 
@@ -327,7 +329,10 @@ fn hostile_strings_stay_inside_comments() {
     result.provenance.created = "2026\nvoid light evil 0 0 3 1 1 1".into();
     result.provenance.command_line = vec!["brtf}".into(), "{fit\r\n".into()];
     result.provenance.inputs[0].path = "a\nb.mpc".into();
-    result.incidences[0].warnings = vec!["θ ≥ 5°\n{oops}".into()];
+    result.incidences[0].warnings = vec![brtf_fit::FitWarning::AtBound {
+        param: "θ ≥ 5°\n{oops}".into(),
+        value: 1.0,
+    }];
     let export = exports(&result, &ExportOptions::default()).unwrap();
     for f in &export.files {
         assert!(f.text.is_ascii(), "{}", f.file_name);

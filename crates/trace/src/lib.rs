@@ -37,6 +37,7 @@
 //! deterministic and independent of the thread count.
 
 pub mod camera;
+pub mod check;
 pub mod frame;
 pub mod gonio;
 pub mod hdr;

@@ -3,8 +3,8 @@
 
 mod args;
 
-pub use args::FitArgs;
 use anyhow::{Context, Result};
+pub use args::FitArgs;
 use brtf_fit::Progress;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
@@ -48,6 +48,9 @@ pub fn run(args: FitArgs) -> Result<()> {
         .write(&out)
         .with_context(|| format!("writing the fit into {}", out.display()))?;
     print!("{}", brtf_fit::summary(&result, &out));
+    for warning in &result.warnings {
+        eprintln!("brtf: warning: {warning}");
+    }
     if !args.no_export {
         let options = brtf_radiance::export::ExportOptions::default();
         let exported = brtf_radiance::export::write_exports(&out, &result, &options)

@@ -1,0 +1,183 @@
+//! The typed contract between `brtf fit` and every command that reads its
+//! folder: the data are rebuilt from the stored recipe (never from the
+//! text shown to people), `fit.json` carries a schema version that every
+//! reader checks, and `brtf check` uses the fit's own scale.
+
+use crate::common::{brtf, repo_path, s, temp_dir};
+use brtf_fit::{FitResult, Gate};
+use std::path::{Path, PathBuf};
+
+fn real_scan(name: &str) -> PathBuf {
+    let path = repo_path("../shared/data/rgl-epfl-pgII-raw").join(name);
+    assert!(path.exists(), "{} is missing", path.display());
+    path
+}
+
+fn shipped_files() -> Vec<String> {
+    let mut files: Vec<String> = std::fs::read_dir(repo_path("data/alu-ggx"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "mpc"))
+        .map(|p| s(&p).to_string())
+        .collect();
+    files.sort();
+    files
+}
+
+fn fit_into(out: &Path, files: &[String], extra: &[&str]) -> FitResult {
+    let mut args: Vec<String> = vec!["fit".into()];
+    args.extend(files.iter().cloned());
+    args.extend(["--out".into(), s(out).to_string()]);
+    args.extend(extra.iter().map(|a| a.to_string()));
+    brtf(&args, "").ok();
+    FitResult::read(out).unwrap()
+}
+
+/// Every sentence a person reads (gates, weighting, warnings, the
+/// conversion) stays out of `fit.json`, and plots and the check rebuild
+/// the fitted data from the typed recipe alone: the plots find exactly
+/// the fitted samples and RMS again, with every kind of gate in use.
+#[test]
+fn fit_json_holds_no_prose_and_plots_and_check_rebuild_the_data() {
+    let dir = temp_dir();
+    let out = dir.path().join("fit");
+    let result = fit_into(
+        &out,
+        &shipped_files(),
+        &["--model", "metal", "--min-value", "1e-6", "--no-export"],
+    );
+    let text = std::fs::read_to_string(out.join("fit.json")).unwrap();
+    let gates = &result.recipe.selections;
+    for kind in [
+        "unavailable",
+        "hemisphere",
+        "theta_cap",
+        "beam_mask",
+        "min_value",
+    ] {
+        assert!(
+            gates
+                .iter()
+                .any(|g| serde_json::to_string(g).unwrap().contains(kind)),
+            "{kind} not among {gates:?}"
+        );
+    }
+    let mut sentences: Vec<String> = gates.iter().map(Gate::to_string).collect();
+    for r in result.incidences.iter().chain(&result.global) {
+        sentences.push(r.weighting.to_string());
+        sentences.extend(r.warnings.iter().map(|w| w.to_string()));
+        sentences.extend(r.gates.iter().map(|g| g.gate.to_string()));
+    }
+    sentences.extend(
+        result
+            .provenance
+            .inputs
+            .iter()
+            .map(|i| i.conversion.to_string()),
+    );
+    assert!(result.incidences.iter().any(|r| !r.warnings.is_empty()));
+    for sentence in &sentences {
+        assert!(
+            !text.contains(sentence.as_str()),
+            "fit.json holds `{sentence}`"
+        );
+    }
+    // The plots rebuild each incidence and compare it with the fit's own
+    // counts and RMS: any disagreement would be a warning.
+    let plot = brtf(&["plot", s(&out)], "");
+    let stderr = plot.stderr.clone();
+    plot.ok();
+    assert!(!stderr.contains("may not be what was fitted"), "{stderr}");
+    assert!(!stderr.contains("may differ from the fit"), "{stderr}");
+    let table = brtf(&["check", s(&out), "--samples", "4"], "").ok();
+    assert!(table.contains("fitted"), "{table}");
+}
+
+/// `brtf check` on a raw-signal fit uses the fit's scale: with `--rho`
+/// the data ÷ K, with a free scale the data ÷ the fitted scale. Before the
+/// recipe, it ignored both and reported a 30× energy error.
+#[test]
+fn check_reports_the_fits_scale_on_raw_signal() {
+    let dir = temp_dir();
+    let scan = s(&real_scan("golden_paper.txt")).to_string();
+    for (label, extra) in [("rho", vec!["--rho", "0.5@27"]), ("free", vec![])] {
+        let out = dir.path().join(label);
+        let mut args = vec!["--model", "metal", "--gray", "--no-plots", "--no-export"];
+        args.extend(extra);
+        let result = fit_into(&out, std::slice::from_ref(&scan), &args);
+        brtf(
+            &[
+                "check",
+                s(&out),
+                "--samples",
+                "2",
+                "--max-directions",
+                "1000000",
+            ],
+            "",
+        )
+        .ok();
+        let csv = std::fs::read_to_string(out.join("check.csv")).unwrap();
+        let mut lines = csv.lines();
+        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let row: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let get = |name: &str| -> f64 {
+            row[header.iter().position(|h| *h == name).unwrap()]
+                .parse()
+                .unwrap()
+        };
+        let energy = get("render_data_energy_ratio");
+        assert!(
+            (energy - 1.0).abs() < 0.1,
+            "{label}: render/data energy {energy}"
+        );
+        // A point beam and detector render the model itself, so on every
+        // fitted direction the rendered-vs-data RMS is the fit's own.
+        let rendered_rms = get("render_vs_data_rms_rel");
+        let fit_rms = result.incidences[0].rms_rel;
+        assert!(
+            (rendered_rms / fit_rms - 1.0).abs() < 1e-3,
+            "{label}: render-data rms {rendered_rms} vs the fit's {fit_rms}"
+        );
+    }
+}
+
+/// A `fit.json` of another schema version gets one clear line from every
+/// command that reads it, naming the file and the version.
+#[test]
+fn other_schema_versions_are_refused_by_every_reader() {
+    let dir = temp_dir();
+    let out = dir.path().join("fit");
+    fit_into(
+        &out,
+        &shipped_files()[..2],
+        &["--model", "metal", "--no-plots", "--no-export"],
+    );
+    let json = out.join("fit.json");
+    let text = std::fs::read_to_string(&json).unwrap();
+    let mut value: serde_json::Value = serde_json::from_str(&text).unwrap();
+    for (found, edit) in [(1, None), (99, Some(99))] {
+        match edit {
+            None => value.as_object_mut().unwrap().remove("schema"),
+            Some(v) => value
+                .as_object_mut()
+                .unwrap()
+                .insert("schema".into(), v.into()),
+        };
+        std::fs::write(&json, serde_json::to_string(&value).unwrap()).unwrap();
+        for command in [
+            vec!["plot", s(&out)],
+            vec!["export", s(&out)],
+            vec!["check", s(&out)],
+            vec!["render", "image", "--fit", s(&out), "--out", "x"],
+        ] {
+            let err = brtf(&command, "").err();
+            let line = err.trim();
+            assert_eq!(line.lines().count(), 1, "{command:?}: {err}");
+            assert!(
+                line.contains(s(&json)) && line.contains(&format!("schema version {found}")),
+                "{command:?}: {err}"
+            );
+        }
+    }
+}
