@@ -118,7 +118,7 @@ pub enum ReadFitError {
         source: std::io::Error,
     },
     /// The file is not JSON, or not a brtf fit of this schema.
-    #[error("{}: not a brtf fit result: {source}", path.display())]
+    #[error("{}:{}: not a brtf fit result: {source}", path.display(), source.line())]
     Parse {
         /// The file.
         path: PathBuf,
@@ -173,7 +173,8 @@ impl FitResult {
                 found,
             });
         }
-        serde_json::from_value(value).map_err(parse)
+        // From the text again, so that errors name their line.
+        serde_json::from_str(text).map_err(parse)
     }
 
     /// Writes `DIR/fit.json` and `DIR/params.csv`, each atomically.
@@ -183,6 +184,7 @@ impl FitResult {
             what: "cannot format",
             source: std::io::Error::other(e),
         })?;
+        brtf_io::ensure_folder(dir)?;
         brtf_io::write_atomic(&dir.join("params.csv"), csv.as_bytes())?;
         brtf_io::write_atomic(&dir.join("fit.json"), self.to_json().as_bytes())
     }

@@ -36,9 +36,18 @@ impl std::error::Error for IoError {
     }
 }
 
+/// Creates `dir` and its parents when missing.
+pub fn ensure_folder(dir: &Path) -> Result<(), IoError> {
+    std::fs::create_dir_all(dir).map_err(|source| IoError {
+        path: dir.to_path_buf(),
+        what: "cannot create folder",
+        source,
+    })
+}
+
 /// Writes `bytes` to `path` through a temporary file beside it and a
-/// rename, creating the folder when needed. On failure the temporary file
-/// is removed and `path` is untouched.
+/// rename. The folder must exist ([`ensure_folder`]). On failure the
+/// temporary file is removed and `path` is untouched.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), IoError> {
     let fail = |what: &'static str, at: &Path| {
         let at = at.to_path_buf();
@@ -52,7 +61,6 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), IoError> {
         Some(dir) if !dir.as_os_str().is_empty() => dir,
         _ => Path::new("."),
     };
-    std::fs::create_dir_all(dir).map_err(fail("cannot create folder", dir))?;
     let mut tmp = tempfile::Builder::new()
         .prefix(".brtf-write-")
         .suffix(".tmp")
@@ -165,6 +173,7 @@ mod tests {
     fn atomic_write_replaces_and_leaves_no_temporary() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("sub/out.txt");
+        ensure_folder(&dir.path().join("sub")).unwrap();
         write_atomic(&path, b"one").unwrap();
         write_atomic(&path, b"two").unwrap();
         assert_eq!(std::fs::read(&path).unwrap(), b"two");
@@ -181,7 +190,9 @@ mod tests {
         let blocker = dir.path().join("file");
         std::fs::write(&blocker, b"x").unwrap();
         let err = write_atomic(&blocker.join("inside.txt"), b"y").unwrap_err();
-        assert_eq!(err.path, blocker);
+        assert_eq!(err.path, blocker.join("inside.txt"));
+        assert_eq!(err.what, "cannot write");
+        let err = ensure_folder(&blocker.join("sub")).unwrap_err();
         assert_eq!(err.what, "cannot create folder");
     }
 

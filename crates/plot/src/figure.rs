@@ -253,8 +253,13 @@ pub fn base64(bytes: &[u8]) -> String {
 }
 
 /// Writes `bytes` to `path` atomically (see [`brtf_io::write_atomic`]).
+/// Creates the folder when missing.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), PlotError> {
-    brtf_io::write_atomic(path, bytes).map_err(|e| PlotError::Io {
+    let folder = path.parent().filter(|p| !p.as_os_str().is_empty());
+    folder
+        .map_or(Ok(()), brtf_io::ensure_folder)
+        .and_then(|()| brtf_io::write_atomic(path, bytes))
+        .map_err(|e| PlotError::Io {
         path: e.path,
         what: e.what,
         source: e.source,

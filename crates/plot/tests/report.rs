@@ -148,7 +148,14 @@ fn no_incidence_is_an_error_and_a_bad_fit_json_names_its_line() {
     assert!(err.to_string().contains("no incidences"), "{err}");
     std::fs::write(dir.path().join("fit.json"), "{\n  \"name\": 3\n}\n").unwrap();
     let err = brtf_plot::read_fit(dir.path()).unwrap_err().to_string();
-    assert!(err.contains("fit.json:2:"), "{err}");
+    assert!(err.contains("schema version 1"), "{err}");
+    std::fs::write(
+        dir.path().join("fit.json"),
+        "{\n  \"schema\": 2,\n  \"name\": 3\n}\n",
+    )
+    .unwrap();
+    let err = brtf_plot::read_fit(dir.path()).unwrap_err().to_string();
+    assert!(err.contains("fit.json:3:"), "{err}");
     let err = brtf_plot::read_fit(&dir.path().join("nowhere"))
         .unwrap_err()
         .to_string();
