@@ -7,6 +7,7 @@
 mod common;
 
 mod convert;
+mod encoding;
 mod integral;
 mod measurement;
 mod read;

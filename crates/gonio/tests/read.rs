@@ -252,7 +252,7 @@ fn format_detection() {
 
 /// Asserts a parse error of the expected kind whose message names the file
 /// and the line, and returns the message.
-fn expect_error(
+pub(crate) fn expect_error(
     result: Result<brtf_gonio::Measurement, ReadError>,
     name: &str,
     line: usize,
@@ -438,16 +438,14 @@ fn binary_junk() {
         )
     });
     assert!(msg.contains("not a text file"), "{msg}");
-    let bytes = b"#intheta 1\n\xff\xfe\x80\n";
-    expect_error(read_bytes(bytes, "utf.mpc"), "utf.mpc", 2, |k| {
-        matches!(
-            k,
-            ParseErrorKind::Binary {
-                what: "invalid UTF-8",
-                ..
-            }
-        )
+    // Bytes that are not UTF-8 are read as Latin-1 (see `encoding.rs`), so
+    // junk in a data row is reported as the bad field it is.
+    let mut bytes = format!("{MOUNTAIN_MIN}10 20 1\n").into_bytes();
+    bytes.extend_from_slice(b"\xff\xfe\x80 1 2\n");
+    let msg = expect_error(read_bytes(&bytes, "junk.txt"), "junk.txt", 5, |k| {
+        matches!(k, ParseErrorKind::NotANumber { column: 1, .. })
     });
+    assert!(msg.contains("found `ÿþ€`"), "{msg}");
 }
 
 #[test]

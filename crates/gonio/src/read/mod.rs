@@ -2,19 +2,22 @@
 //!
 //! This module owns the entry points ([`read_path`], [`read_bytes`] and the
 //! per-format variants), format detection, and everything both readers
-//! share: the text check (empty, NUL bytes, invalid UTF-8), the line walk
-//! with 1-based line numbers, number fields with the sentinel rule, and the
+//! share: the text check (empty, NUL bytes; decoding lives in `text`:
+//! UTF-8 with a Latin-1 fallback per line), the line walk with 1-based
+//! line numbers, number fields with the sentinel rule, and the
 //! incidence found in a file name (`…:+15+0.mpc`). The format specifics
 //! live in the private submodules `mpc` and `mountain`.
 //!
 //! Input is read in one go and parsed from the byte buffer; rows are split
-//! on ASCII whitespace (spaces or tabs) and CRLF line ends are accepted.
+//! on ASCII whitespace (spaces or tabs); lines end at LF, CRLF or a lone CR.
 //! No input makes a reader panic.
 
 pub(crate) mod mountain;
 pub(crate) mod mpc;
 mod number;
+mod text;
 
+use std::borrow::Cow;
 use std::path::Path;
 
 use crate::error::{ParseErrorKind, ReadError};
@@ -58,8 +61,8 @@ pub fn read_bytes_as(
     let name = name.as_ref();
     let text = check_text(bytes, name)?;
     match format {
-        SourceFormat::Mpc => mpc::parse(text, name),
-        SourceFormat::Mountain => mountain::parse(text, name),
+        SourceFormat::Mpc => mpc::parse(&text, name),
+        SourceFormat::Mountain => mountain::parse(&text, name),
     }
 }
 
@@ -75,11 +78,11 @@ pub fn detect_format(bytes: &[u8], name: &Path) -> SourceFormat {
     if has_mpc_extension {
         return SourceFormat::Mpc;
     }
-    // Only the head of the file matters; invalid UTF-8 is reported later.
+    // Only the head of the file matters, and only its ASCII keys.
     let head = &bytes[..bytes.len().min(64 * 1024)];
     let head = String::from_utf8_lossy(head);
     let mut mpc_marker = false;
-    for line in head.lines() {
+    for (_, line) in text::Lines::new(&head) {
         let line = line.trim();
         if line.is_empty() {
             continue;
@@ -127,44 +130,27 @@ pub(crate) fn parse_error(name: &Path, line: usize, kind: ParseErrorKind) -> Rea
     }
 }
 
-/// Rejects empty and binary input and returns the text (without a BOM).
-fn check_text<'a>(bytes: &'a [u8], name: &Path) -> Result<&'a str, ReadError> {
+/// Rejects empty and binary input and returns the text (without a BOM),
+/// with lines that are not UTF-8 read as Latin-1.
+fn check_text<'a>(bytes: &'a [u8], name: &Path) -> Result<Cow<'a, str>, ReadError> {
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
     if bytes.iter().all(u8::is_ascii_whitespace) {
         return Err(parse_error(name, 1, ParseErrorKind::Empty));
     }
-    let line_at = |offset: usize| 1 + bytes[..offset].iter().filter(|&&b| b == b'\n').count();
-    if bytes.contains(&0)
-        && let Some(offset) = bytes.iter().position(|&b| b == 0)
-    {
+    if let Some(offset) = bytes.iter().position(|&b| b == 0) {
         let kind = ParseErrorKind::Binary {
             what: "NUL byte",
             offset,
         };
-        return Err(parse_error(name, line_at(offset), kind));
+        return Err(parse_error(name, text::line_number_at(bytes, offset), kind));
     }
-    std::str::from_utf8(bytes).map_err(|e| {
-        let offset = e.valid_up_to();
-        let kind = ParseErrorKind::Binary {
-            what: "invalid UTF-8",
-            offset,
-        };
-        parse_error(name, line_at(offset), kind)
-    })
+    Ok(text::decode(bytes))
 }
 
-/// The non-blank lines of `text` with their 1-based numbers, `\r` removed.
+/// The non-blank lines of `text` with their 1-based numbers, line ends
+/// (`\n`, `\r\n` or a lone `\r`) removed.
 pub(crate) fn numbered_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
-    text.split('\n')
-        .enumerate()
-        .map(|(i, line)| {
-            let line = match line.as_bytes().last() {
-                Some(b'\r') => &line[..line.len() - 1],
-                _ => line,
-            };
-            (i + 1, line)
-        })
-        .filter(|(_, line)| !line.trim_ascii().is_empty())
+    text::Lines::new(text).filter(|(_, line)| !line.trim_ascii().is_empty())
 }
 
 /// A cursor over the whitespace-separated number fields of one data row.
