@@ -181,3 +181,82 @@ fn other_schema_versions_are_refused_by_every_reader() {
         }
     }
 }
+
+/// A parameter that ends at a bound has no standard error, and every
+/// command that reads the folder still works. A metal fitted to a purely
+/// diffuse sample ends with its specularity at 0; before, its standard
+/// error was written as `null` and `plot`, `check`, `export` and `render`
+/// failed with `invalid type: null`.
+#[test]
+fn a_parameter_at_a_bound_breaks_no_command() {
+    let dir = temp_dir();
+    let rad = dir.path().join("white.rad");
+    std::fs::write(&rad, "void plastic white 0 0 5 0.6 0.6 0.6 0 0\n").unwrap();
+    let set = dir.path().join("set");
+    brtf(
+        &[
+            "synth",
+            "--material",
+            s(&rad),
+            "--theta-in",
+            "0,30,60",
+            "--out",
+            s(&set),
+            "--noise",
+            "0",
+            "--noise-floor",
+            "0",
+        ],
+        "",
+    )
+    .ok();
+    let mut files: Vec<String> = std::fs::read_dir(&set)
+        .unwrap()
+        .map(|e| s(&e.unwrap().path()).to_string())
+        .collect();
+    files.sort();
+    let out = dir.path().join("fit");
+    let result = fit_into(&out, &files, &["--model", "metal", "--gray"]);
+    let bounded: Vec<_> = result
+        .incidences
+        .iter()
+        .flat_map(|r| &r.params)
+        .filter(|p| p.at_bound)
+        .collect();
+    assert!(!bounded.is_empty(), "no parameter at a bound");
+    for p in &bounded {
+        assert_eq!(p.stderr, None, "{p:?}");
+        assert_eq!(p.missing_error_reason(), Some("at bound"));
+    }
+    let text = std::fs::read_to_string(out.join("fit.json")).unwrap();
+    assert!(text.contains("\"stderr\": null"), "no null standard error");
+    let summary_csv = std::fs::read_to_string(out.join("params.csv")).unwrap();
+    assert!(!summary_csv.contains("NaN"), "{summary_csv}");
+    let report = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(
+        report.contains("at bound"),
+        "report.html does not say `at bound`"
+    );
+    brtf(&["plot", s(&out)], "").ok();
+    brtf(&["export", s(&out)], "").ok();
+    brtf(&["check", s(&out), "--samples", "4"], "").ok();
+    let picture = dir.path().join("pic");
+    brtf(
+        &[
+            "render",
+            "image",
+            "--fit",
+            s(&out),
+            "--out",
+            s(&picture),
+            "--width",
+            "16",
+            "--height",
+            "12",
+            "--samples",
+            "1",
+        ],
+        "",
+    )
+    .ok();
+}

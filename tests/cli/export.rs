@@ -49,8 +49,8 @@ fn report(kind: MaterialKind, theta_in: f64, args: &[f64]) -> FitReport {
             .map(|(name, &value)| ParamEstimate {
                 name: (*name).into(),
                 value,
-                stderr: 1e-3,
-                stderr_robust: 1e-3,
+                stderr: Some(1e-3),
+                stderr_robust: Some(1e-3),
                 at_bound: false,
                 fixed: false,
             })
@@ -162,6 +162,7 @@ fn result_of(
         table,
         interpolation: method,
         warnings: Vec::new(),
+        outputs: Vec::new(),
     }
 }
 

@@ -219,11 +219,15 @@ impl Reported<'_> {
         let final_pass = at_solution
             .ok_or_else(|| failed("non-finite residuals or Jacobian at the solution"))?;
         let errors = standard_errors(&final_pass, cost, problem.n_residuals(), map.len());
+        // No standard error at a bound: the logistic's derivative is ~0
+        // there, and a symmetric error bar would mean nothing anyway.
         let physical_error = |i: usize| {
-            (
-                errors.plain[i] * dp[i].abs(),
-                errors.robust[i] * dp[i].abs(),
-            )
+            let known = |e: f64| Some(e * dp[i].abs()).filter(|v| v.is_finite());
+            if map.at_bound(i, p[i]) {
+                (None, None)
+            } else {
+                (known(errors.plain[i]), known(errors.robust[i]))
+            }
         };
 
         // Every material argument by name, then the free scale.
@@ -246,8 +250,8 @@ impl Reported<'_> {
                 None => ParamEstimate {
                     name: (*name).into(),
                     value: args[a],
-                    stderr: 0.0,
-                    stderr_robust: 0.0,
+                    stderr: None,
+                    stderr_robust: None,
                     at_bound: false,
                     fixed: true,
                 },
@@ -278,10 +282,12 @@ impl Reported<'_> {
         // than 2×.
         let understated: Vec<StderrRatio> = params
             .iter()
-            .filter(|p| !p.fixed && !p.at_bound && p.stderr_robust > 2.0 * p.stderr)
-            .map(|p| StderrRatio {
-                param: p.name.clone(),
-                ratio: p.stderr_robust / p.stderr,
+            .filter_map(|p| match (p.stderr, p.stderr_robust) {
+                (Some(plain), Some(robust)) if robust > 2.0 * plain => Some(StderrRatio {
+                    param: p.name.clone(),
+                    ratio: robust / plain,
+                }),
+                _ => None,
             })
             .collect();
         if !understated.is_empty() {

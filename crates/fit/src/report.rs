@@ -82,14 +82,14 @@ pub struct ParamEstimate {
     pub name: String,
     /// Fitted value.
     pub value: f64,
-    /// Standard error from s²(JᵀJ)⁻¹ (0 for a parameter held fixed).
-    pub stderr: f64,
+    /// Standard error from s²(JᵀJ)⁻¹; `None` (`null` in fit.json) when
+    /// there is none: the parameter is held fixed, ended at a bound (where
+    /// the error of a bounded parameter means nothing), or JᵀJ is singular.
+    pub stderr: Option<f64>,
     /// Heteroscedasticity-consistent standard error from the sandwich
     /// `m/(m−n) (JᵀJ)⁻¹ (Σ rᵢ² Jᵢ Jᵢᵀ) (JᵀJ)⁻¹`, which does not assume
-    /// equal residual variances (absent in fit.json files written before
-    /// it existed: 0).
-    #[serde(default)]
-    pub stderr_robust: f64,
+    /// equal residual variances; `None` as for `stderr`.
+    pub stderr_robust: Option<f64>,
     /// Ended at a physical bound (its standard error is then meaningless).
     pub at_bound: bool,
     /// Held fixed rather than fitted.
@@ -97,14 +97,27 @@ pub struct ParamEstimate {
 }
 
 impl ParamEstimate {
-    /// The larger of the two standard errors (a non-finite one is
-    /// ignored): the one to show when the residuals' variance may not be
-    /// uniform.
-    pub fn uncertainty(&self) -> f64 {
-        [self.stderr, self.stderr_robust]
-            .into_iter()
-            .filter(|v| v.is_finite())
-            .fold(f64::NAN, f64::max)
+    /// The larger of the two standard errors: the one to show when the
+    /// residuals' variance may not be uniform. `None` when there is none.
+    pub fn uncertainty(&self) -> Option<f64> {
+        match (self.stderr, self.stderr_robust) {
+            (Some(a), Some(b)) => Some(a.max(b)),
+            (a, b) => a.or(b),
+        }
+    }
+
+    /// Why there is no standard error, for tables: `at bound`, `fixed` or
+    /// `singular`; `None` when there is one.
+    pub fn missing_error_reason(&self) -> Option<&'static str> {
+        if self.stderr.is_some() {
+            None
+        } else if self.fixed {
+            Some("fixed")
+        } else if self.at_bound {
+            Some("at bound")
+        } else {
+            Some("singular")
+        }
     }
 }
 
@@ -162,12 +175,12 @@ impl FitReport {
         self.params.iter().find(|p| p.name == name).map(|p| p.value)
     }
 
-    /// Standard error of the parameter called `name`.
+    /// Standard error of the parameter called `name`, when it has one.
     pub fn stderr(&self, name: &str) -> Option<f64> {
         self.params
             .iter()
             .find(|p| p.name == name)
-            .map(|p| p.stderr)
+            .and_then(|p| p.stderr)
     }
 }
 

@@ -103,6 +103,11 @@ pub struct FitResult {
     /// Warnings about the whole set.
     #[serde(default)]
     pub warnings: Vec<SetWarning>,
+    /// Every other file of the fit folder, with its SHA-256 and the step
+    /// that wrote it (`docs/fit-json.md`, "Output files"). Empty until the
+    /// folder is complete, and in folders written before the listing.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub outputs: Vec<brtf_io::OutputFile>,
 }
 
 /// Why `fit.json` could not be read.
@@ -254,7 +259,12 @@ impl FitResult {
         let row = |r: &FitReport, theta: String, phi: String| -> Vec<String> {
             let mut v = vec![theta, phi, r.n_points.to_string()];
             v.extend(r.params.iter().map(|p| format!("{:.8}", p.value)));
-            v.extend(r.params.iter().map(|p| format!("{:.3e}", p.stderr)));
+            // An empty cell where there is no standard error.
+            v.extend(
+                r.params
+                    .iter()
+                    .map(|p| p.stderr.map_or_else(String::new, |e| format!("{e:.3e}"))),
+            );
             v.extend([
                 format!("{:.6}", r.rms_rel),
                 format!("{:.6e}", r.cost),

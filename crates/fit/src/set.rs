@@ -181,6 +181,7 @@ pub fn fit_set(
         table,
         interpolation: options.interpolation,
         warnings,
+        outputs: Vec::new(),
     })
 }
 

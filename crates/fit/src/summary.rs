@@ -46,7 +46,14 @@ pub fn summary(result: &FitResult, out: &Path) -> String {
             } else {
                 " "
             };
-            let _ = write!(s, " {:>8.5}±{:<7.1e}{}", p.value, p.stderr, flag);
+            match (p.stderr, p.missing_error_reason()) {
+                (Some(e), _) => {
+                    let _ = write!(s, " {:>8.5}±{:<7.1e}{}", p.value, e, flag);
+                }
+                (None, reason) => {
+                    let _ = write!(s, " {:>8.5} {:<8}{}", p.value, reason.unwrap_or(""), flag);
+                }
+            }
         }
         let _ = writeln!(
             s,

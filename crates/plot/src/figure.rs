@@ -260,10 +260,10 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), PlotError> {
         .map_or(Ok(()), brtf_io::ensure_folder)
         .and_then(|()| brtf_io::write_atomic(path, bytes))
         .map_err(|e| PlotError::Io {
-        path: e.path,
-        what: e.what,
-        source: e.source,
-    })
+            path: e.path,
+            what: e.what,
+            source: e.source,
+        })
 }
 
 /// Renders `chart` and writes `<dir>/<name>.svg` and `<dir>/<name>.png`.

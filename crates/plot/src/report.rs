@@ -120,10 +120,17 @@ fn param_cell(r: &FitReport, name: &str) -> String {
         None => "–".into(),
         Some(p) if p.fixed => format!("{} <span class=\"muted\">(fixed)</span>", fmt6(p.value)),
         Some(p) if p.at_bound => format!(
-            "{} <span class=\"bound\" title=\"at a bound: the standard error is meaningless\">!</span>",
+            "{} <span class=\"bound\" title=\"ended at a bound of its range: no standard error\">at bound</span>",
             fmt6(p.value)
         ),
-        Some(p) => format!("{} ± {}", fmt6(p.value), fmt_err(p.uncertainty())),
+        Some(p) => match p.uncertainty() {
+            Some(e) => format!("{} ± {}", fmt6(p.value), fmt_err(e)),
+            None => format!(
+                "{} <span class=\"muted\">(no standard error: {})</span>",
+                fmt6(p.value),
+                p.missing_error_reason().unwrap_or("singular")
+            ),
+        },
     }
 }
 

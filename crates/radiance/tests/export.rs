@@ -23,8 +23,8 @@ fn report(kind: MaterialKind, theta_in: f64, args: &[f64]) -> FitReport {
             .map(|(name, &value)| ParamEstimate {
                 name: (*name).into(),
                 value,
-                stderr: 2e-3,
-                stderr_robust: 2e-3,
+                stderr: Some(2e-3),
+                stderr_robust: Some(2e-3),
                 at_bound: false,
                 fixed: false,
             })
@@ -101,6 +101,7 @@ fn fit(
         table,
         interpolation: Interpolation::Pchip,
         warnings: Vec::new(),
+        outputs: Vec::new(),
     }
 }
 

@@ -252,11 +252,7 @@ impl ParamsChart<'_> {
         for (_, name, _) in &panel.series {
             for r in &result.incidences {
                 if let Some(p) = param(r, name) {
-                    let se = if p.uncertainty().is_finite() && !p.at_bound {
-                        p.uncertainty()
-                    } else {
-                        0.0
-                    };
+                    let se = p.uncertainty().filter(|_| !p.at_bound).unwrap_or(0.0);
                     ys.extend([p.value - se, p.value + se]);
                 }
             }
@@ -297,7 +293,7 @@ impl ParamsChart<'_> {
                 .filter_map(|r| param(r, name).map(|p| (r.theta_in, p)))
                 .collect();
             for (t, p) in &points {
-                let se = p.uncertainty();
+                let se = p.uncertainty().unwrap_or(0.0);
                 if se.is_finite() && se > 0.0 && !p.at_bound {
                     let (lo, hi) = (p.value - se, p.value + se);
                     let style = colour.stroke_width(1);
