@@ -5,10 +5,19 @@
 //! * [`sha256_hex`]: the digest recorded for every input in `fit.json`.
 //! * [`locate_input`]: finds an input file recorded in a fit folder again,
 //!   from wherever the user runs a later command.
+//! * [`FolderUpdate`]: an output folder written into a staging folder,
+//!   under a lock, and swapped in as a whole (`folder.rs`).
+//! * [`OutputFile`]: the listing of an output folder's files with their
+//!   digests and the step that wrote them (`outputs.rs`).
 //!
 //! Errors are plain [`std::io::Error`]s with the path in [`IoError`], so
 //! each crate can wrap them in its own error type.
 
+mod folder;
+mod outputs;
+
+pub use folder::{FolderUpdate, leftovers};
+pub use outputs::{OutputFile, Producer, describe_outputs, folder_files, replace_outputs};
 use sha2::{Digest, Sha256};
 use std::io::Write;
 use std::path::{Path, PathBuf};

@@ -1,0 +1,435 @@
+//! Output folders committed as a whole.
+//!
+//! A run writes everything into a staging folder beside its target
+//! (`.NAME.brtf-stage-*`) and then swaps it in with one rename, so that a
+//! reader sees the old folder or the new one, never a mix. A lock file
+//! beside the target (`.NAME.brtf-lock`, an advisory `flock`) keeps two
+//! runs from writing the same folder. Whatever a killed run left (staging
+//! folders, the old folder of an interrupted swap) is removed by the next
+//! run that takes the lock.
+
+use crate::IoError;
+use std::fs::File;
+use std::path::{Path, PathBuf};
+
+/// The name pieces of brtf's hidden files beside a target folder.
+const STAGE: &str = ".brtf-stage-";
+const OLD: &str = ".brtf-old-";
+const LOCK: &str = ".brtf-lock";
+
+/// A rewrite of an output folder in progress. Dropping it without
+/// [`FolderUpdate::commit`] removes the staging folder and leaves the
+/// target untouched.
+#[derive(Debug)]
+pub struct FolderUpdate {
+    target: PathBuf,
+    staging: PathBuf,
+    lock: FolderLock,
+    committed: bool,
+    /// Written in place: `staging` is the target itself.
+    in_place: bool,
+}
+
+impl FolderUpdate {
+    /// Locks `target` and starts an empty staging folder: the committed
+    /// folder will hold exactly what is written into [`FolderUpdate::path`].
+    pub fn fresh(target: &Path) -> Result<FolderUpdate, IoError> {
+        FolderUpdate::start(target, false)
+    }
+
+    /// Locks `target` and starts a staging folder that holds the target's
+    /// present files (hard links, else copies), for commands that replace
+    /// only some of a folder's files. A folder that exists but is not a fit
+    /// folder (no `fit.json`) may hold anything of the user's: it is not
+    /// taken over but written in place, file by file (each file atomic).
+    pub fn amend(target: &Path) -> Result<FolderUpdate, IoError> {
+        FolderUpdate::start(target, true)
+    }
+
+    fn start(target: &Path, keep_content: bool) -> Result<FolderUpdate, IoError> {
+        let (parent, name) = split_target(target)?;
+        crate::ensure_folder(&parent)?;
+        let target = parent.join(&name);
+        if target.exists() && !target.is_dir() {
+            return Err(IoError {
+                path: target,
+                what: "cannot write the output folder",
+                source: std::io::Error::other("a file of that name exists"),
+            });
+        }
+        let lock = FolderLock::take(&parent.join(format!(".{name}{LOCK}")), &target)?;
+        remove_leftovers(&parent, &name, &target)?;
+        if keep_content && target.is_dir() && !target.join("fit.json").exists() {
+            return Ok(FolderUpdate {
+                staging: target.clone(),
+                target,
+                lock,
+                committed: false,
+                in_place: true,
+            });
+        }
+        let staging = tempfile::Builder::new()
+            .prefix(&format!(".{name}{STAGE}"))
+            .tempdir_in(&parent)
+            .map_err(fail("cannot create a staging folder in", &parent))?
+            .keep();
+        let update = FolderUpdate {
+            target,
+            staging,
+            lock,
+            committed: false,
+            in_place: false,
+        };
+        if keep_content && update.target.is_dir() {
+            link_tree(&update.target, &update.staging)?;
+        }
+        Ok(update)
+    }
+
+    /// The staging folder: write every output here.
+    pub fn path(&self) -> &Path {
+        &self.staging
+    }
+
+    /// The folder that [`FolderUpdate::commit`] replaces.
+    pub fn target(&self) -> &Path {
+        &self.target
+    }
+
+    /// Syncs the staging folder and swaps it in for the target, then
+    /// removes the old folder and the lock.
+    pub fn commit(mut self) -> Result<(), IoError> {
+        if self.in_place {
+            self.committed = true;
+            self.lock.release();
+            return Ok(());
+        }
+        // The files are synced by write_atomic; the folder entries too.
+        sync_dir(&self.staging);
+        let parent = self.target.parent().unwrap_or(Path::new("."));
+        if self.target.exists() {
+            swap(&self.staging, &self.target)?;
+            // The staging path now holds the old folder.
+            remove_tree(&self.staging);
+        } else {
+            std::fs::rename(&self.staging, &self.target)
+                .map_err(fail("cannot move the new folder into", &self.target))?;
+        }
+        sync_dir(parent);
+        self.committed = true;
+        self.lock.release();
+        Ok(())
+    }
+}
+
+impl Drop for FolderUpdate {
+    fn drop(&mut self) {
+        if !self.committed && !self.in_place {
+            remove_tree(&self.staging);
+        }
+        if !self.committed {
+            self.lock.release();
+        }
+    }
+}
+
+/// The absolute parent and the file name of `target` (`fits/x` → the
+/// current folder's `fits`, `x`).
+fn split_target(target: &Path) -> Result<(PathBuf, String), IoError> {
+    let absolute = std::path::absolute(target).map_err(fail("cannot resolve", target))?;
+    // `x/.` and `x/..` have no plain last name; resolve them through the disk.
+    let resolved = match absolute.file_name() {
+        Some(_) => absolute,
+        None => std::fs::canonicalize(&absolute).map_err(fail("cannot resolve", target))?,
+    };
+    match (resolved.parent(), resolved.file_name()) {
+        (Some(parent), Some(name)) => Ok((parent.to_path_buf(), name.to_string_lossy().into())),
+        _ => Err(IoError {
+            path: target.to_path_buf(),
+            what: "cannot use as an output folder",
+            source: std::io::Error::other("it is the root folder"),
+        }),
+    }
+}
+
+/// An exclusive advisory lock on a file beside the target.
+#[derive(Debug)]
+struct FolderLock {
+    path: PathBuf,
+    file: Option<File>,
+}
+
+impl FolderLock {
+    /// Takes the lock or fails at once, naming `target`, when another run
+    /// holds it.
+    fn take(path: &Path, target: &Path) -> Result<FolderLock, IoError> {
+        loop {
+            let file = File::options()
+                .create(true)
+                .truncate(false)
+                .write(true)
+                .open(path)
+                .map_err(fail("cannot create the lock file", path))?;
+            if !try_lock(&file).map_err(fail("cannot lock", path))? {
+                return Err(IoError {
+                    path: target.to_path_buf(),
+                    what: "cannot write the output folder",
+                    source: std::io::Error::other(
+                        "another brtf run is writing it; wait for that run to finish \
+                         or choose another output folder",
+                    ),
+                });
+            }
+            // A run that finished between our open and our lock removed the
+            // file we locked; lock the file now at the path instead.
+            if same_file(&file, path) {
+                return Ok(FolderLock {
+                    path: path.to_path_buf(),
+                    file: Some(file),
+                });
+            }
+        }
+    }
+
+    /// Removes the lock file, then unlocks (closing the file).
+    fn release(&mut self) {
+        if let Some(file) = self.file.take() {
+            let _ = std::fs::remove_file(&self.path);
+            drop(file);
+        }
+    }
+}
+
+#[cfg(unix)]
+fn try_lock(file: &File) -> std::io::Result<bool> {
+    use rustix::fs::{FlockOperation, flock};
+    match flock(file, FlockOperation::NonBlockingLockExclusive) {
+        Ok(()) => Ok(true),
+        Err(e) if e == rustix::io::Errno::WOULDBLOCK => Ok(false),
+        Err(e) => Err(e.into()),
+    }
+}
+
+#[cfg(not(unix))]
+fn try_lock(_file: &File) -> std::io::Result<bool> {
+    // No advisory locks here: runs are not serialised.
+    Ok(true)
+}
+
+#[cfg(unix)]
+fn same_file(file: &File, path: &Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    match (file.metadata(), std::fs::metadata(path)) {
+        (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
+        _ => false,
+    }
+}
+
+#[cfg(not(unix))]
+fn same_file(_file: &File, _path: &Path) -> bool {
+    true
+}
+
+/// Swaps two folders in one step where the system can
+/// (`renameat2(RENAME_EXCHANGE)`), else with two renames (a reader may then
+/// briefly find no folder; [`remove_leftovers`] undoes a half-done swap).
+fn swap(staging: &Path, target: &Path) -> Result<(), IoError> {
+    #[cfg(any(target_os = "linux", target_os = "android"))]
+    {
+        use rustix::fs::{CWD, RenameFlags, renameat_with};
+        if renameat_with(CWD, staging, CWD, target, RenameFlags::EXCHANGE).is_ok() {
+            return Ok(());
+        }
+    }
+    let name = target.file_name().unwrap_or_default().to_string_lossy();
+    let parent = target.parent().unwrap_or(Path::new("."));
+    let old = parent.join(format!(".{name}{OLD}{}", std::process::id()));
+    std::fs::rename(target, &old).map_err(fail("cannot move aside", target))?;
+    if let Err(e) = std::fs::rename(staging, target) {
+        let _ = std::fs::rename(&old, target);
+        return Err(fail("cannot move the new folder into", target)(e));
+    }
+    // Keep the promise of `commit`: the staging path holds the old folder.
+    std::fs::rename(&old, staging).map_err(fail("cannot move", &old))
+}
+
+/// Removes what dead runs left beside `target` (the caller holds the
+/// lock, so no live run owns them). An old folder left by a swap that
+/// stopped half-way is moved back when the target is missing.
+fn remove_leftovers(parent: &Path, name: &str, target: &Path) -> Result<(), IoError> {
+    for path in leftovers(parent, name) {
+        let file_name = path.file_name().unwrap_or_default().to_string_lossy();
+        let is_old = file_name.starts_with(&format!(".{name}{OLD}"));
+        if is_old && !target.exists() {
+            std::fs::rename(&path, target).map_err(fail("cannot restore", target))?;
+        } else {
+            remove_tree(&path);
+        }
+    }
+    Ok(())
+}
+
+/// brtf's staging and old folders beside the target `parent/name`.
+pub fn leftovers(parent: &Path, name: &str) -> Vec<PathBuf> {
+    let prefixes = [format!(".{name}{STAGE}"), format!(".{name}{OLD}")];
+    let Ok(entries) = std::fs::read_dir(parent) else {
+        return Vec::new();
+    };
+    let mut found: Vec<PathBuf> = entries
+        .filter_map(Result::ok)
+        .filter(|e| {
+            let n = e.file_name();
+            let n = n.to_string_lossy();
+            prefixes.iter().any(|p| n.starts_with(p.as_str()))
+        })
+        .map(|e| e.path())
+        .collect();
+    found.sort();
+    found
+}
+
+/// Mirrors the tree `from` into the empty folder `to` with hard links
+/// (copies where links fail), skipping temporary files of interrupted
+/// writes.
+fn link_tree(from: &Path, to: &Path) -> Result<(), IoError> {
+    let entries = std::fs::read_dir(from).map_err(fail("cannot read", from))?;
+    for entry in entries {
+        let entry = entry.map_err(fail("cannot read", from))?;
+        let (source, dest) = (entry.path(), to.join(entry.file_name()));
+        if is_temporary_name(&entry.file_name().to_string_lossy()) {
+            continue;
+        }
+        let kind = entry.file_type().map_err(fail("cannot read", &source))?;
+        if kind.is_dir() {
+            std::fs::create_dir(&dest).map_err(fail("cannot create folder", &dest))?;
+            link_tree(&source, &dest)?;
+        } else if std::fs::hard_link(&source, &dest).is_err() {
+            std::fs::copy(&source, &dest).map_err(fail("cannot copy", &source))?;
+        }
+    }
+    Ok(())
+}
+
+/// A temporary file of [`crate::write_atomic`] (left by a killed run).
+fn is_temporary_name(name: &str) -> bool {
+    name.starts_with(".brtf-write-") && name.ends_with(".tmp")
+}
+
+fn remove_tree(path: &Path) {
+    let _ = std::fs::remove_dir_all(path);
+}
+
+/// Makes a folder's entries durable (best effort: not every system can
+/// sync a folder).
+fn sync_dir(dir: &Path) {
+    if let Ok(d) = File::open(dir) {
+        let _ = d.sync_all();
+    }
+}
+
+fn fail(what: &'static str, at: &Path) -> impl FnOnce(std::io::Error) -> IoError {
+    let path = at.to_path_buf();
+    move |source| IoError { path, what, source }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn names(dir: &Path) -> Vec<String> {
+        let mut n: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        n.sort();
+        n
+    }
+
+    #[test]
+    fn fresh_update_replaces_the_whole_folder() {
+        let root = tempfile::tempdir().unwrap();
+        let target = root.path().join("fit");
+        std::fs::create_dir(&target).unwrap();
+        std::fs::write(target.join("stale.rad"), b"old").unwrap();
+        let update = FolderUpdate::fresh(&target).unwrap();
+        crate::write_atomic(&update.path().join("new.rad"), b"new").unwrap();
+        assert_eq!(names(&target), ["stale.rad"], "untouched until commit");
+        update.commit().unwrap();
+        assert_eq!(names(&target), ["new.rad"]);
+        assert_eq!(names(root.path()), ["fit"], "no staging, old or lock left");
+    }
+
+    #[test]
+    fn amend_keeps_other_files_and_dropping_changes_nothing() {
+        let root = tempfile::tempdir().unwrap();
+        let target = root.path().join("fit");
+        std::fs::create_dir_all(target.join("plots")).unwrap();
+        std::fs::write(target.join("fit.json"), b"{}").unwrap();
+        std::fs::write(target.join("plots/a.svg"), b"a").unwrap();
+        std::fs::write(target.join(".brtf-write-x.tmp"), b"").unwrap();
+        let update = FolderUpdate::amend(&target).unwrap();
+        crate::write_atomic(&update.path().join("plots/a.svg"), b"b").unwrap();
+        drop(update);
+        assert_eq!(std::fs::read(target.join("plots/a.svg")).unwrap(), b"a");
+        assert_eq!(names(root.path()), ["fit"]);
+        let update = FolderUpdate::amend(&target).unwrap();
+        crate::write_atomic(&update.path().join("plots/a.svg"), b"b").unwrap();
+        update.commit().unwrap();
+        assert_eq!(names(&target), ["fit.json", "plots"]);
+        assert_eq!(std::fs::read(target.join("plots/a.svg")).unwrap(), b"b");
+    }
+
+    #[test]
+    fn a_second_run_is_refused_while_the_first_holds_the_lock() {
+        let root = tempfile::tempdir().unwrap();
+        let target = root.path().join("fit");
+        let first = FolderUpdate::fresh(&target).unwrap();
+        let err = FolderUpdate::fresh(&target).unwrap_err();
+        assert!(err.to_string().contains("another brtf run"), "{err}");
+        drop(first);
+        FolderUpdate::fresh(&target).unwrap().commit().unwrap();
+        assert_eq!(names(root.path()), ["fit"]);
+    }
+
+    #[test]
+    fn leftovers_of_dead_runs_are_removed_and_a_half_swap_undone() {
+        let root = tempfile::tempdir().unwrap();
+        std::fs::create_dir(root.path().join(".fit.brtf-stage-dead")).unwrap();
+        std::fs::create_dir(root.path().join(".fit.brtf-old-1")).unwrap();
+        std::fs::write(root.path().join(".fit.brtf-old-1/fit.json"), b"{}").unwrap();
+        std::fs::write(root.path().join(".fit.brtf-lock"), b"").unwrap();
+        let update = FolderUpdate::amend(&root.path().join("fit")).unwrap();
+        assert_eq!(
+            names(update.path()),
+            ["fit.json"],
+            "the old folder restored"
+        );
+        update.commit().unwrap();
+        assert_eq!(names(root.path()), ["fit"]);
+    }
+
+    #[test]
+    fn a_folder_that_is_not_a_fit_folder_is_written_in_place() {
+        let root = tempfile::tempdir().unwrap();
+        let target = root.path().join("scene");
+        std::fs::create_dir(&target).unwrap();
+        std::fs::write(target.join("mine.txt"), b"x").unwrap();
+        let update = FolderUpdate::amend(&target).unwrap();
+        assert_eq!(update.path(), target);
+        crate::write_atomic(&update.path().join("a.rad"), b"a").unwrap();
+        update.commit().unwrap();
+        assert_eq!(names(&target), ["a.rad", "mine.txt"]);
+        assert_eq!(names(root.path()), ["scene"]);
+    }
+
+    #[test]
+    fn a_file_in_the_way_is_an_error() {
+        let root = tempfile::tempdir().unwrap();
+        std::fs::write(root.path().join("fit"), b"x").unwrap();
+        let err = FolderUpdate::fresh(&root.path().join("fit")).unwrap_err();
+        assert!(
+            err.to_string().contains("a file of that name exists"),
+            "{err}"
+        );
+    }
+}
