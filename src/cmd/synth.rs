@@ -33,7 +33,7 @@ pub struct SynthArgs {
     /// Output format.
     #[arg(long, value_enum, default_value_t = FormatArg::Mpc)]
     pub format: FormatArg,
-    /// Values per row: 1 (CIE-Y: mean of R, G, B) or 3 (Mountain only).
+    /// Values per row: 1 (CIE-Y, the luminance) or 3 (CIE X, Y, Z; Mountain only).
     #[arg(long, default_value_t = 1)]
     pub channels: usize,
     /// Output folder.

@@ -260,3 +260,90 @@ fn a_parameter_at_a_bound_breaks_no_command() {
     )
     .ok();
 }
+
+/// CIE-XYZ files are fitted in Radiance RGB: a plastic of known colour,
+/// written as true XYZ by `brtf synth --channels 3`, is fitted and
+/// exported with its own colour (before, the XYZ values were taken as RGB
+/// and (0.100, 0.401, 0.121) came out as 0.201 0.303 0.154).
+#[test]
+fn xyz_data_are_fitted_and_exported_in_radiance_rgb() {
+    let dir = temp_dir();
+    let rad = dir.path().join("green.rad");
+    std::fs::write(
+        &rad,
+        "void plastic green 0 0 5 0.100 0.401 0.121 0.04 0.1\n",
+    )
+    .unwrap();
+    let set = dir.path().join("set");
+    brtf(
+        &[
+            "synth",
+            "--material",
+            s(&rad),
+            "--theta-in",
+            "0,30,60",
+            "--out",
+            s(&set),
+            "--format",
+            "mountain",
+            "--channels",
+            "3",
+            "--noise",
+            "0",
+            "--noise-floor",
+            "0",
+        ],
+        "",
+    )
+    .ok();
+    let mut files: Vec<String> = std::fs::read_dir(&set)
+        .unwrap()
+        .map(|e| s(&e.unwrap().path()).to_string())
+        .collect();
+    files.sort();
+    // The files hold true XYZ: at normal incidence, every sample is the
+    // XYZ of the material's RGB BSDF.
+    let m = brtf_gonio::read_path(Path::new(&files[0])).unwrap();
+    assert_eq!(m.channels, brtf_gonio::Channels::Xyz);
+    let material = brtf_model::Material::new(
+        brtf_model::MaterialKind::Plastic,
+        &[0.100, 0.401, 0.121, 0.04, 0.1],
+        None,
+    )
+    .unwrap();
+    let bsdf = brtf_model::Bsdf::new(&material, &brtf_model::EvalOptions::default());
+    let sample = m
+        .samples
+        .iter()
+        .find(|s| s.theta_deg > 40.0 && s.theta_deg < 60.0)
+        .unwrap();
+    let want =
+        brtf_model::colour::rgb_to_xyz(bsdf.eval(m.incidence.direction(), sample.direction()));
+    for (got, want) in sample.values.iter().zip(want) {
+        assert!(
+            (got / want - 1.0).abs() < 1e-6,
+            "{:?} vs {want:?}",
+            sample.values
+        );
+    }
+    let out = dir.path().join("fit");
+    let result = fit_into(&out, &files, &["--model", "plastic", "--no-plots"]);
+    assert_eq!(
+        result.recipe.colour,
+        brtf_fit::ColourConversion::XyzToRadianceRgb
+    );
+    let exported = std::fs::read_to_string(out.join("green.rad"))
+        .or_else(|_| std::fs::read_to_string(out.join("set.rad")))
+        .unwrap();
+    let words: Vec<f64> = exported
+        .lines()
+        .filter(|l| !l.trim_start().starts_with('#'))
+        .flat_map(|l| l.split_whitespace())
+        .filter_map(|w| w.parse().ok())
+        .collect();
+    // `void plastic NAME 0 0 5 r g b spec rough`: the five reals come last.
+    let reals = &words[words.len() - 5..];
+    for (got, want) in reals[..3].iter().zip([0.100, 0.401, 0.121]) {
+        assert!((got / want - 1.0).abs() < 0.01, "colour {reals:?}");
+    }
+}

@@ -5,7 +5,8 @@
 //! so they cannot disagree.
 //!
 //! In order:
-//! 1. **Colour**: three-channel data are taken as recorded.
+//! 1. **Colour**: three-channel files hold CIE X, Y, Z; they become
+//!    Radiance RGB ([`brtf_model::colour`]), the colour the models use.
 //! 2. **Weights**: solid angles of the full layout (the file's Voronoi
 //!    cells, else computed), before any selection; or uniform.
 //! 3. **Conversion** to the fitted quantity ([`Conversion`]): BSDF as is;
@@ -46,8 +47,22 @@ pub enum ScaleRule {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ColourConversion {
-    /// As recorded: three channels are taken as Radiance RGB, one as grey.
+    /// Three channels are CIE X, Y, Z (as the files' colorimetry says):
+    /// converted to Radiance RGB. One channel (CIE Y) is fitted grey.
+    XyzToRadianceRgb,
+    /// As recorded: three channels are taken as Radiance RGB already (for
+    /// files that hold RGB under an XYZ header, such as those written by
+    /// brtf before it wrote true XYZ).
     AsRecorded,
+}
+
+impl std::fmt::Display for ColourConversion {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            ColourConversion::XyzToRadianceRgb => "CIE XYZ converted to Radiance RGB",
+            ColourConversion::AsRecorded => "three channels taken as Radiance RGB",
+        })
+    }
 }
 
 /// Which weights the fit gives the samples.
@@ -94,7 +109,7 @@ impl Recipe {
         });
         Recipe {
             scale: ScaleRule::FromFiles,
-            colour: ColourConversion::AsRecorded,
+            colour: ColourConversion::XyzToRadianceRgb,
             selections,
             weights: WeightRule::SolidAngle,
         }
@@ -288,6 +303,13 @@ impl Recipe {
             (WeightRule::SolidAngle, SolidAngleSource::File) => Weighting::FileSolidAngles,
             (WeightRule::SolidAngle, SolidAngleSource::Computed) => Weighting::ComputedSolidAngles,
         };
+        if self.colour == ColourConversion::XyzToRadianceRgb
+            && measurement.channels == brtf_gonio::Channels::Xyz
+        {
+            for sample in &mut measurement.samples {
+                sample.values = brtf_model::colour::xyz_to_rgb(sample.values);
+            }
+        }
         let (measurement, conversion) = self.convert(&measurement, source)?;
         let context = GateContext::of(&measurement);
         let mut removed_by = vec![None; measurement.len()];

@@ -14,7 +14,7 @@ use crate::measurement::{
     Channels, Incidence, IncidenceOrigin, Measurement, Quantity, Sample, SourceFormat,
 };
 use crate::solid_angle::compute_solid_angles;
-use brtf_model::{Bsdf, Rng, direction};
+use brtf_model::{Bsdf, Rng, colour, direction};
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -162,7 +162,8 @@ pub struct SynthSpec {
     pub instrument: Instrument,
     /// Sampling layout.
     pub layout: Layout,
-    /// 1 (CIE-Y, the mean of the three channels) or 3 values per row.
+    /// 1 (CIE-Y, the luminance) or 3 (CIE X, Y, Z) values per row, of
+    /// the material's Radiance RGB.
     pub channels: Channels,
     /// Seed of the noise (the layout itself is deterministic).
     pub seed: u64,
@@ -310,16 +311,16 @@ pub fn synthesize(spec: &SynthSpec) -> Measurement {
             value * (1.0 + instrument.noise_relative * rng.normal())
                 + instrument.noise_floor * rng.normal()
         };
+        // The file holds what its colorimetry header says: CIE Y, or CIE
+        // XYZ, of the material's Radiance RGB.
+        let rgb = mean.map(|m| m / n);
         let values = match spec.channels {
-            Channels::Y => [
-                noisy((mean[0] + mean[1] + mean[2]) / (3.0 * n), &mut rng),
-                0.0,
-                0.0,
-            ],
+            Channels::Y => [noisy(colour::luminance(rgb), &mut rng), 0.0, 0.0],
             Channels::Xyz => {
                 let k = 1.0 + instrument.noise_relative * rng.normal();
                 let floor = [rng.normal(), rng.normal(), rng.normal()];
-                [0, 1, 2].map(|c| mean[c] / n * k + instrument.noise_floor * floor[c])
+                let xyz = colour::rgb_to_xyz(rgb);
+                [0, 1, 2].map(|c| xyz[c] * k + instrument.noise_floor * floor[c])
             }
         };
         samples.push(Sample::new(theta, phi, values));

@@ -26,6 +26,7 @@
 
 mod albedo;
 mod bsdf;
+pub mod colour;
 mod kind;
 mod material;
 mod options;

@@ -22,7 +22,6 @@ use brtf_model::Rgb;
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::image::LUMINANCE_WEIGHTS;
 use crate::integrator::{RayCounts, Settings, Tracer};
 use crate::rng::Rng;
 use crate::sampling::{cone_half_angle, one_minus_cos, uniform_cone};
@@ -367,11 +366,12 @@ pub fn stratified_cells(n: usize, rng: &mut Rng) -> Vec<[f64; 2]> {
         .collect()
 }
 
-/// Measurement slot values of a rendered RGB value.
+/// Measurement slot values of a rendered RGB value: its luminance, or its
+/// CIE XYZ (what the file's colorimetry header says the values are).
 pub fn channel_values(c: Rgb, channels: Channels) -> [f64; 3] {
     match channels {
-        Channels::Y => [(0..3).map(|k| LUMINANCE_WEIGHTS[k] * c[k]).sum(), 0.0, 0.0],
-        Channels::Xyz => c,
+        Channels::Y => [brtf_model::colour::luminance(c), 0.0, 0.0],
+        Channels::Xyz => brtf_model::colour::rgb_to_xyz(c),
     }
 }
 

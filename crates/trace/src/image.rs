@@ -108,12 +108,9 @@ pub fn render(scene: &Scene, camera: &Camera, options: &ImageOptions) -> Rendere
     }
 }
 
-/// Radiance's luminance weights for its RGB primaries (`bright()`).
-pub const LUMINANCE_WEIGHTS: [f64; 3] = [0.265_074_126, 0.670_114_631, 0.064_811_243];
-
-/// Luminance-like brightness of an RGB value.
+/// Luminance-like brightness of an RGB value (Radiance's `bright()`).
 pub fn brightness(c: [f32; 3]) -> f64 {
-    (0..3).map(|k| LUMINANCE_WEIGHTS[k] * c[k] as f64).sum()
+    brtf_model::colour::luminance(c.map(f64::from))
 }
 
 /// The exposure that maps the 97th percentile of the non-zero pixel

@@ -54,6 +54,10 @@ pub struct FitArgs {
     /// Robust loss: none, huber[:C] or cauchy[:C] (C in robust standard deviations).
     #[arg(long, default_value = "none", value_parser = parse_loss)]
     pub loss: RobustLoss,
+    /// What three-channel files hold: CIE X, Y, Z (converted to Radiance
+    /// RGB), or RGB already (files from brtf before it wrote true XYZ).
+    #[arg(long, value_enum, default_value_t = ColourArg::Xyz)]
+    pub colour: ColourArg,
     /// Fit weights: the samples' solid angles (file Voronoi cells, else computed) or uniform.
     #[arg(long, value_enum, default_value_t = WeightsArg::SolidAngle)]
     pub weights: WeightsArg,
@@ -101,6 +105,14 @@ pub enum ResidualArg {
     Relative,
     Absolute,
     Log,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, ValueEnum)]
+pub enum ColourArg {
+    /// Three channels are CIE X, Y, Z: converted to Radiance RGB.
+    Xyz,
+    /// Three channels are Radiance RGB already.
+    AsRecorded,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, ValueEnum)]
@@ -211,7 +223,10 @@ impl FitArgs {
                     Some(value) => ScaleRule::BeamIntegral { value },
                     None => ScaleRule::FromFiles,
                 },
-                colour: ColourConversion::AsRecorded,
+                colour: match self.colour {
+                    ColourArg::Xyz => ColourConversion::XyzToRadianceRgb,
+                    ColourArg::AsRecorded => ColourConversion::AsRecorded,
+                },
                 selections,
                 weights: match self.weights {
                     WeightsArg::SolidAngle => WeightRule::SolidAngle,

@@ -52,7 +52,8 @@ pub struct GonioArgs {
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Values per sample in the output file: `y` (luminance) or `rgb`
-    /// (the material's three channels) [default: the --like file's, else y].
+    /// (the material's colour, written as CIE X, Y, Z) [default: the --like
+    /// file's, else y].
     #[arg(long, value_enum)]
     pub channels: Option<ChannelsArg>,
     /// Output measurement file: `.mpc` (ISE) or anything else (Mountain).
