@@ -1,0 +1,205 @@
+//! What each case runs: the parser, then what brtf does next with an
+//! accepted input (so a parser that lets a bad value through is caught
+//! where it would hurt).
+//!
+//! * measurements: read; on success summarise (as `brtf info`), write as
+//!   Mountain and `.mpc` and read back (as `brtf convert`);
+//! * `.rad`: parse, pick the material (as `brtf eval`), convert every
+//!   primitive, evaluate each material, print and re-parse primitives;
+//! * `fit.json`: read; on success write it again, build `params.csv`, the
+//!   materials at several θ_in and the Radiance exports (as `brtf export`).
+//!
+//! Beyond panics, an "anomaly" is a wrong result that is no crash: an
+//! error that does not start with `file:line` (line ≥ 1 and inside the
+//! file), a written file that does not read back, or a valid material
+//! whose BSDF is not finite.
+
+use std::path::Path;
+
+use brtf_gonio::{Measurement, SourceFormat};
+use brtf_model::{Bsdf, EvalOptions, Material};
+use glam::DVec3;
+
+use crate::seeds::Target;
+
+/// How a case ended (a panic never returns here; the runner catches it).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Outcome {
+    /// The input was accepted.
+    Accepted,
+    /// The input was refused with this error message.
+    Rejected(String),
+    /// Something is wrong without a crash; the text says what.
+    Anomaly(String),
+}
+
+/// Runs `bytes`, named `name`, through `target`.
+pub fn exercise(target: Target, name: &str, bytes: &[u8]) -> Outcome {
+    match target {
+        Target::Mpc => gonio(bytes, name, Some(SourceFormat::Mpc)),
+        Target::Mountain => gonio(bytes, name, Some(SourceFormat::Mountain)),
+        Target::DetectedGonio => gonio(bytes, name, None),
+        Target::Rad => rad(bytes, name),
+        Target::FitJson => fit_json(bytes, name),
+    }
+}
+
+fn gonio(bytes: &[u8], name: &str, format: Option<SourceFormat>) -> Outcome {
+    let result = match format {
+        Some(format) => brtf_gonio::read_bytes_as(bytes, name, format),
+        None => brtf_gonio::read_bytes(bytes, name),
+    };
+    let measurement = match result {
+        Ok(m) => m,
+        Err(e) => {
+            let message = e.to_string();
+            let lines = line_count(bytes, true);
+            return match e.line() {
+                Some(line) if line == 0 || line > lines => Outcome::Anomaly(format!(
+                    "error on line {line} of a {lines}-line file: {message}"
+                )),
+                _ => located(message, name),
+            };
+        }
+    };
+    let _ = measurement.summary();
+    if let Some(problem) = round_trip(&measurement, name) {
+        return Outcome::Anomaly(problem);
+    }
+    Outcome::Accepted
+}
+
+/// Writes `m` in both formats and reads it back; `Some(problem)` if that fails.
+fn round_trip(m: &Measurement, name: &str) -> Option<String> {
+    let mountain = brtf_gonio::to_mountain_string(m);
+    match brtf_gonio::read_bytes_as(mountain.as_bytes(), name, SourceFormat::Mountain) {
+        Ok(again) if again.len() == m.len() => {}
+        Ok(again) => {
+            return Some(format!(
+                "written as Mountain, {} rows read back as {}",
+                m.len(),
+                again.len()
+            ));
+        }
+        Err(e) => return Some(format!("written as Mountain, does not read back: {e}")),
+    }
+    if let Ok(mpc) = brtf_gonio::to_mpc_string(m) {
+        match brtf_gonio::read_bytes_as(mpc.as_bytes(), name, SourceFormat::Mpc) {
+            Ok(again) if again.len() == m.len() => {}
+            Ok(again) => {
+                return Some(format!(
+                    "written as .mpc, {} rows read back as {}",
+                    m.len(),
+                    again.len()
+                ));
+            }
+            Err(e) => return Some(format!("written as .mpc, does not read back: {e}")),
+        }
+    }
+    None
+}
+
+fn rad(bytes: &[u8], name: &str) -> Outcome {
+    // `brtf eval` reads the file with `read_to_string`, which refuses
+    // non-UTF-8; the lossy text still reaches the parser's corners.
+    let text = String::from_utf8_lossy(bytes);
+    let primitives = match brtf_radiance::parse_primitives(&text, name) {
+        Ok(p) => p,
+        Err(e) => return rad_error(&e, bytes, name),
+    };
+    for p in &primitives {
+        if let Ok(material) = brtf_radiance::material_from_primitive(p, name)
+            && let Some(problem) = eval_problem(&material)
+        {
+            return Outcome::Anomaly(format!("`{}` ({}): {problem}", p.name, p.kind));
+        }
+        let printed = brtf_radiance::format_primitive(p);
+        if let Err(e) = brtf_radiance::parse_primitives(&printed, name) {
+            return Outcome::Anomaly(format!("a printed primitive does not parse again: {e}"));
+        }
+    }
+    match brtf_radiance::select_material(&primitives, None, name) {
+        Ok(_) => Outcome::Accepted,
+        Err(e) => rad_error(&e, bytes, name),
+    }
+}
+
+fn rad_error(e: &brtf_radiance::RadError, bytes: &[u8], name: &str) -> Outcome {
+    let lines = line_count(bytes, false);
+    if e.line == 0 || e.line > lines {
+        return Outcome::Anomaly(format!(
+            "error on line {} of a {lines}-line file: {e}",
+            e.line
+        ));
+    }
+    located(e.to_string(), name)
+}
+
+fn fit_json(bytes: &[u8], name: &str) -> Outcome {
+    // `FitResult::read` uses `read_to_string`: non-UTF-8 is an I/O error
+    // before the parser; the lossy text goes further.
+    let text = String::from_utf8_lossy(bytes);
+    let result = match brtf_fit::FitResult::from_json(&text, Path::new(name)) {
+        Ok(r) => r,
+        Err(e) => return located(e.to_string(), name),
+    };
+    let _ = result.to_json();
+    let _ = result.params_csv();
+    let mut thetas: Vec<f64> = result.incidences.iter().map(|r| r.theta_in).collect();
+    thetas.extend([0.0, 22.5, 45.0, 89.9]);
+    for theta in thetas {
+        if let Some(material) = result.material_at(theta, None)
+            && let Some(problem) = eval_problem(&material)
+        {
+            return Outcome::Anomaly(format!("material at theta_in = {theta}: {problem}"));
+        }
+    }
+    match brtf_radiance::export::exports(&result, &brtf_radiance::export::ExportOptions::default())
+    {
+        Ok(_) => Outcome::Accepted,
+        Err(e) => Outcome::Rejected(e.to_string()),
+    }
+}
+
+/// Evaluates `material` at a few (l, v) pairs: normal, oblique, grazing,
+/// mirror and back side. `Some(problem)` when a value is not finite.
+fn eval_problem(material: &Material) -> Option<String> {
+    let bsdf = Bsdf::new(material, &EvalOptions::default());
+    let dir = |theta: f64, phi: f64| {
+        let (t, p) = (theta.to_radians(), phi.to_radians());
+        DVec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos())
+    };
+    let pairs = [
+        (dir(0.0, 0.0), dir(0.0, 0.0)),
+        (dir(30.0, 0.0), dir(30.0, 180.0)),
+        (dir(60.0, 0.0), dir(20.0, 90.0)),
+        (dir(89.99, 0.0), dir(89.99, 180.0)),
+        (dir(30.0, 0.0), dir(150.0, 180.0)),
+    ];
+    pairs.iter().find_map(|&(l, v)| {
+        let value = bsdf.eval(l, v);
+        (!value.iter().all(|x| x.is_finite())).then(|| format!("eval gives {value:?}"))
+    })
+}
+
+/// Rejected when the message starts with `name:`, else an anomaly.
+fn located(message: String, name: &str) -> Outcome {
+    let prefix = format!("{name}:");
+    if message.starts_with(&prefix) {
+        Outcome::Rejected(message)
+    } else {
+        Outcome::Anomaly(format!("error does not start with `{prefix}`: {message}"))
+    }
+}
+
+/// Lines in `bytes`, counting `\n` (and, when `lone_cr`, `\r` not followed
+/// by `\n`, as the measurement readers do) plus a last unterminated line.
+fn line_count(bytes: &[u8], lone_cr: bool) -> usize {
+    let mut ends = 0;
+    for (i, &b) in bytes.iter().enumerate() {
+        if b == b'\n' || (lone_cr && b == b'\r' && bytes.get(i + 1) != Some(&b'\n')) {
+            ends += 1;
+        }
+    }
+    ends + 1
+}
