@@ -36,8 +36,14 @@ enum Command {
     Plot(cmd::plot::PlotArgs),
 }
 
+/// Exit codes (docs/outputs.md): 0 on success and when the reader of
+/// standard output has gone (as ripgrep), 1 on every error, the command
+/// line's included; `--help` and `--version` exit 0.
 fn main() {
-    let cli = Cli::parse();
+    let cli = Cli::try_parse().unwrap_or_else(|e| {
+        let _ = e.print();
+        std::process::exit(if e.use_stderr() { 1 } else { 0 })
+    });
     let result = match cli.command {
         Command::Eval(args) => cmd::eval::run(args),
         Command::Albedo(args) => cmd::albedo::run(args),
@@ -50,6 +56,9 @@ fn main() {
         Command::Plot(args) => cmd::plot::run(args),
     };
     if let Err(err) = result {
+        if cmd::output::is_broken_pipe(&err) {
+            std::process::exit(0);
+        }
         eprintln!("brtf: error: {err:#}");
         std::process::exit(1);
     }

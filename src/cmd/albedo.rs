@@ -27,15 +27,14 @@ pub struct AlbedoArgs {
 }
 
 pub fn run(args: AlbedoArgs) -> Result<()> {
-    let bsdf = args.material.bsdf()?;
     for &t in &args.theta_in {
-        anyhow::ensure!(
-            t.is_finite() && (0.0..=180.0).contains(&t),
-            "--theta-in {t}: must be between 0 and 180 degrees"
-        );
+        brtf_model::check_incidence(t, args.phi_in)?;
     }
-    let stdout = std::io::stdout();
-    let mut out = BufWriter::new(stdout.lock());
+    let tolerance = args.tolerance;
+    let ok = tolerance > 0.0 && tolerance < 1.0;
+    brtf_model::OptionError::check("--tolerance", tolerance, ok, "0 < tolerance < 1")?;
+    let bsdf = args.material.bsdf()?;
+    let mut out = BufWriter::new(crate::cmd::output::stdout());
     writeln!(
         out,
         "theta_in,phi_in,rho_r,rho_g,rho_b,tau_r,tau_g,tau_b,rho_spike,tau_spike"

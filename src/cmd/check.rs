@@ -63,7 +63,7 @@ pub fn run(args: CheckArgs) -> Result<()> {
         search_dirs: args.search_dirs.clone(),
     };
     let report = with_jobs(args.jobs, || check_fit(&fit, &args.dir, &options))??;
-    print!("{report}");
+    super::output::print(&report.to_string())?;
     let out = args
         .out
         .clone()

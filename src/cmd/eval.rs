@@ -20,6 +20,7 @@ pub struct EvalArgs {
 }
 
 pub fn run(args: EvalArgs) -> Result<()> {
+    brtf_model::check_incidence(args.theta_in, args.phi_in)?;
     let bsdf = args.material.bsdf()?;
     let l = direction(args.theta_in, args.phi_in);
     let stdin = std::io::stdin();

@@ -30,9 +30,9 @@ struct FileSummary {
 }
 
 pub fn run(args: InfoArgs) -> anyhow::Result<()> {
-    let stdout = std::io::stdout();
-    let mut out = stdout.lock();
-    write_report(&args, &mut out)
+    let mut out = crate::cmd::output::stdout();
+    write_report(&args, &mut out)?;
+    Ok(out.flush()?)
 }
 
 /// Summarises every file of `args` into `out`. Stops at the first file that

@@ -59,17 +59,15 @@ impl MaterialArgs {
     }
 
     pub fn options(&self) -> Result<EvalOptions> {
-        anyhow::ensure!(
-            self.source_omega.is_finite() && self.source_omega >= 0.0,
-            "--source-omega must be a non-negative number of steradians"
-        );
-        Ok(EvalOptions {
+        let options = EvalOptions {
             variant: self.variant,
             fresnel_k: self.fresnel_k,
             source_omega: self.source_omega,
             flat: !self.curved,
             source_jitter: 0.0,
-        })
+        };
+        options.validate()?;
+        Ok(options)
     }
 
     pub fn bsdf(&self) -> Result<Bsdf> {

@@ -1,7 +1,10 @@
-//! Output files go through [`brtf_io::write_atomic`], so a failed run
-//! leaves nothing half-written.
+//! Where results go. Files are written through [`brtf_io::write_atomic`]
+//! (a failed run leaves nothing half-written), output folders through
+//! [`brtf_io::FolderUpdate`], and text through [`Stdout`], whose errors
+//! say that standard output failed; `main` exits quietly on a closed pipe.
 
 use anyhow::Result;
+use std::io::Write;
 use std::path::Path;
 
 /// Writes `bytes` to `path` atomically (same-folder temporary + rename),
@@ -11,4 +14,60 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
         brtf_io::ensure_folder(folder)?;
     }
     Ok(brtf_io::write_atomic(path, bytes)?)
+}
+
+/// Lists `fresh`, the files `by` wrote into the staged folder `stage`, in
+/// its `fit.json`, and removes the files `by` listed there before and did
+/// not write again. A folder without `fit.json` keeps no listing.
+pub fn relist(stage: &Path, fresh: &[std::path::PathBuf], by: brtf_io::Producer) -> Result<()> {
+    let path = stage.join("fit.json");
+    if !path.exists() {
+        return Ok(());
+    }
+    let mut fit = brtf_fit::FitResult::read(&path)?;
+    let fresh = brtf_io::describe_outputs(stage, fresh, by)?;
+    fit.outputs = brtf_io::replace_outputs(stage, &fit.outputs, fresh, by)?;
+    Ok(brtf_io::write_atomic(&path, fit.to_json().as_bytes())?)
+}
+
+/// Standard output whose errors name it and keep their kind (so that
+/// [`is_broken_pipe`] can tell a reader that left from a failure).
+pub struct Stdout(std::io::StdoutLock<'static>);
+
+/// The locked standard output.
+pub fn stdout() -> Stdout {
+    Stdout(std::io::stdout().lock())
+}
+
+fn named(e: std::io::Error) -> std::io::Error {
+    std::io::Error::new(e.kind(), format!("cannot write to standard output: {e}"))
+}
+
+impl Write for Stdout {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.0.write(buf).map_err(named)
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.0.flush().map_err(named)
+    }
+}
+
+/// Prints `text` to standard output and flushes it.
+pub fn print(text: &str) -> Result<()> {
+    let mut out = stdout();
+    out.write_all(text.as_bytes())?;
+    Ok(out.flush()?)
+}
+
+/// Whether `err` comes from writing into a pipe whose reader has gone
+/// (`brtf … | head -1`).
+pub fn is_broken_pipe(err: &anyhow::Error) -> bool {
+    err.chain().any(|cause| {
+        cause
+            .downcast_ref::<std::io::Error>()
+            .is_some_and(|e| e.kind() == std::io::ErrorKind::BrokenPipe)
+            || cause
+                .downcast_ref::<csv::Error>()
+                .is_some_and(|e| matches!(e.kind(), csv::ErrorKind::Io(io) if io.kind() == std::io::ErrorKind::BrokenPipe))
+    })
 }

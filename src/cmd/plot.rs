@@ -2,7 +2,10 @@
 //! `report.html` for a fit folder (what `brtf fit` also draws unless
 //! `--no-plots`).
 
+use super::output::{print, relist};
+use super::shared::read_fit;
 use anyhow::{Context, Result};
+use brtf_io::{FolderUpdate, Producer};
 use clap::Args;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -36,21 +39,27 @@ pub fn run(args: PlotArgs) -> Result<()> {
         );
     }
     let started = Instant::now();
-    let options = brtf_plot::PlotOptions {
+    let mut options = brtf_plot::PlotOptions {
         search_dirs: args.search_dirs,
         ratio: args.ratio,
         plane_tolerance_deg: args.plane_tolerance,
     };
-    let written = brtf_plot::plot_dir(&args.dir, &options)
+    let result = read_fit(&args.dir)?;
+    // Into a copy of the folder, swapped in at the end: replaces the plots
+    // and the report, keeps the rest.
+    let update = FolderUpdate::amend(&args.dir)?;
+    options.search_dirs.push(args.dir.clone());
+    let written = brtf_plot::write_plots(update.path(), &result, &options)
         .with_context(|| format!("cannot plot {}", args.dir.display()))?;
+    relist(update.path(), &written.files, Producer::Plot)?;
+    update.commit()?;
     for w in &written.warnings {
         eprintln!("brtf: warning: {w}");
     }
-    println!(
-        "brtf plot: {} files in {:.2} s -> {}",
+    print(&format!(
+        "brtf plot: {} files in {:.2} s -> {}\n",
         written.files.len(),
         started.elapsed().as_secs_f64(),
-        written.report.display()
-    );
-    Ok(())
+        args.dir.join("report.html").display()
+    ))
 }

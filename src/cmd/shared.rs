@@ -25,8 +25,8 @@ pub fn with_jobs<T: Send>(jobs: Option<usize>, f: impl FnOnce() -> T + Send) -> 
 }
 
 /// A CSV writer on stdout (buffered; flush it at the end).
-pub fn csv_stdout() -> csv::Writer<std::io::StdoutLock<'static>> {
-    csv::Writer::from_writer(std::io::stdout().lock())
+pub fn csv_stdout() -> csv::Writer<crate::cmd::output::Stdout> {
+    csv::Writer::from_writer(crate::cmd::output::stdout())
 }
 
 /// Writes one CSV row of numbers, each as Rust's `{}` prints it (the

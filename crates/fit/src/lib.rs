@@ -44,6 +44,7 @@ mod solve;
 mod summary;
 mod table;
 mod uncertainty;
+mod validate;
 
 /// Serialises a material type as its Radiance name.
 pub(crate) mod serde_kind {

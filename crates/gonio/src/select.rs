@@ -69,6 +69,31 @@ impl GateContext {
 }
 
 impl Gate {
+    /// Checks a gate's number, named by its `brtf fit` option:
+    /// `--theta-cap` in (0, 90], `--beam-mask` in [0, 90), `--min-value`
+    /// finite.
+    pub fn validate(&self) -> Result<(), brtf_model::OptionError> {
+        use brtf_model::OptionError;
+        match *self {
+            Gate::Unavailable | Gate::Hemisphere { .. } => Ok(()),
+            Gate::ThetaCap { max_deg } => OptionError::check(
+                "--theta-cap",
+                max_deg,
+                max_deg > 0.0 && max_deg <= 90.0,
+                "0 < θ ≤ 90 degrees",
+            ),
+            Gate::BeamMask { half_angle_deg: a } => OptionError::check(
+                "--beam-mask",
+                a,
+                (0.0..90.0).contains(&a),
+                "0 ≤ half-angle < 90 degrees",
+            ),
+            Gate::MinValue { min } => {
+                OptionError::check("--min-value", min, min.is_finite(), "a finite number")
+            }
+        }
+    }
+
     /// True when `sample` passes the gate.
     pub fn keeps(&self, sample: &Sample, context: &GateContext) -> bool {
         let values = &sample.values[..context.channels];

@@ -133,6 +133,125 @@ impl Drop for FolderUpdate {
     }
 }
 
+/// Refuses to let a run replace `target` as a whole when that would lose
+/// work: always when an input file lies inside it; without `force`, when
+/// it is not a brtf folder (no `fit.json`) but holds files, or when its
+/// `fit.json` names an input that is not among `inputs` (by content or by
+/// file name): the fit of another sample.
+pub fn check_replaceable(target: &Path, inputs: &[PathBuf], force: bool) -> Result<(), IoError> {
+    let refuse = |why: String| IoError {
+        path: target.to_path_buf(),
+        what: "cannot replace the output folder",
+        source: std::io::Error::other(why),
+    };
+    let Ok(folder) = std::fs::canonicalize(target) else {
+        return Ok(());
+    };
+    for input in inputs {
+        if std::fs::canonicalize(input).is_ok_and(|i| i.starts_with(&folder)) {
+            return Err(refuse(format!(
+                "it holds the input {}, and a run replaces the whole folder; choose another output folder",
+                input.display()
+            )));
+        }
+    }
+    let is_empty = std::fs::read_dir(&folder).is_ok_and(|mut d| d.next().is_none());
+    if force || is_empty {
+        return Ok(());
+    }
+    let fit_json = folder.join("fit.json");
+    let Ok(text) = std::fs::read_to_string(&fit_json) else {
+        return Err(refuse(
+            "it is not a brtf fit folder (no fit.json); --force replaces it".into(),
+        ));
+    };
+    let recorded = recorded_inputs(&text);
+    let digests: Vec<String> = inputs
+        .iter()
+        .filter_map(|i| std::fs::read(i).ok())
+        .map(|b| crate::sha256_hex(&b))
+        .collect();
+    let file_name = |p: &str| Path::new(p).file_name().map(|n| n.to_os_string());
+    let others: Vec<&str> = recorded
+        .iter()
+        .filter(|(path, sha)| {
+            !digests.contains(sha)
+                && !inputs
+                    .iter()
+                    .any(|i| i.file_name() == file_name(path).as_deref())
+        })
+        .map(|(path, _)| path.as_str())
+        .collect();
+    match (recorded.is_empty(), others.as_slice()) {
+        (true, _) => Err(refuse(format!(
+            "{} names no input files; --force replaces it",
+            fit_json.display()
+        ))),
+        (false, []) => Ok(()),
+        (false, others) => Err(refuse(format!(
+            "it holds the fit of other measurements ({}); choose another output folder, or --force to replace it",
+            others.join(", ")
+        ))),
+    }
+}
+
+/// Refuses, unless `force`, to write `output` when it is one of `inputs`
+/// (`render gonio --like X --out X`) or, with a `marker`, when it exists
+/// and its first 4 KiB do not hold `marker`: a file this command did not
+/// write, such as a real measurement under `brtf synth`'s file name.
+pub fn check_overwrite(
+    output: &Path,
+    inputs: &[&Path],
+    marker: Option<&str>,
+    force: bool,
+) -> Result<(), IoError> {
+    let refuse = |why: &str| IoError {
+        path: output.to_path_buf(),
+        what: "refusing to overwrite",
+        source: std::io::Error::other(format!("{why}; --force overwrites it")),
+    };
+    let Ok(existing) = std::fs::canonicalize(output) else {
+        return Ok(());
+    };
+    if force {
+        return Ok(());
+    }
+    if inputs
+        .iter()
+        .any(|i| std::fs::canonicalize(i).is_ok_and(|i| i == existing))
+    {
+        return Err(refuse("it is an input of this run"));
+    }
+    if let Some(marker) = marker {
+        let mut head = Vec::new();
+        let file = File::open(&existing).map_err(fail("cannot read", output))?;
+        std::io::Read::read_to_end(&mut std::io::Read::take(file, 4096), &mut head)
+            .map_err(fail("cannot read", output))?;
+        if !String::from_utf8_lossy(&head).contains(marker) {
+            return Err(refuse(&format!(
+                "it exists and this command did not write it (its header lacks `{marker}`)"
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// `provenance.inputs[]` (`path`, `sha256`) of a `fit.json` of any schema.
+fn recorded_inputs(fit_json: &str) -> Vec<(String, String)> {
+    let value: serde_json::Value = serde_json::from_str(fit_json).unwrap_or_default();
+    let inputs = value["provenance"]["inputs"].as_array().cloned();
+    inputs
+        .unwrap_or_default()
+        .iter()
+        .filter_map(|i| {
+            Some((
+                i["path"].as_str()?.to_owned(),
+                i["sha256"].as_str()?.to_owned(),
+            ))
+        })
+        .collect()
+}
+
 /// The absolute parent and the file name of `target` (`fits/x` → the
 /// current folder's `fits`, `x`).
 fn split_target(target: &Path) -> Result<(PathBuf, String), IoError> {
@@ -420,6 +539,57 @@ mod tests {
         update.commit().unwrap();
         assert_eq!(names(&target), ["a.rad", "mine.txt"]);
         assert_eq!(names(root.path()), ["scene"]);
+    }
+
+    #[test]
+    fn only_a_fit_of_the_same_inputs_is_replaced_without_force() {
+        let root = tempfile::tempdir().unwrap();
+        let (a, b) = (
+            root.path().join("a:+0+0.mpc"),
+            root.path().join("b:+0+0.mpc"),
+        );
+        std::fs::write(&a, b"a").unwrap();
+        std::fs::write(&b, b"b").unwrap();
+        let target = root.path().join("fit");
+        check_replaceable(&target, std::slice::from_ref(&a), false).unwrap();
+        std::fs::create_dir(&target).unwrap();
+        check_replaceable(&target, std::slice::from_ref(&a), false).unwrap();
+        std::fs::write(target.join("notes.txt"), b"mine").unwrap();
+        let err = check_replaceable(&target, std::slice::from_ref(&a), false).unwrap_err();
+        assert!(err.to_string().contains("not a brtf fit folder"), "{err}");
+        check_replaceable(&target, std::slice::from_ref(&a), true).unwrap();
+        let fit = format!(
+            r#"{{"provenance": {{"inputs": [{{"path": "x/a:+0+0.mpc", "sha256": "{}"}}]}}}}"#,
+            crate::sha256_hex(b"old a")
+        );
+        std::fs::write(target.join("fit.json"), fit).unwrap();
+        check_replaceable(&target, &[a.clone(), b.clone()], false).unwrap();
+        let err = check_replaceable(&target, std::slice::from_ref(&b), false).unwrap_err();
+        assert!(
+            err.to_string()
+                .contains("other measurements (x/a:+0+0.mpc)"),
+            "{err}"
+        );
+        check_replaceable(&target, &[b], true).unwrap();
+        let inside = target.join("c.mpc");
+        std::fs::write(&inside, b"c").unwrap();
+        let err = check_replaceable(&target, &[inside], true).unwrap_err();
+        assert!(err.to_string().contains("holds the input"), "{err}");
+    }
+
+    #[test]
+    fn inputs_and_foreign_files_are_not_overwritten_without_force() {
+        let root = tempfile::tempdir().unwrap();
+        let scan = root.path().join("scan.mpc");
+        std::fs::write(&scan, b"#real measurement").unwrap();
+        let err = check_overwrite(&scan, &[&scan], None, false).unwrap_err();
+        assert!(err.to_string().contains("is an input"), "{err}");
+        let err = check_overwrite(&scan, &[], Some("brtf synth"), false).unwrap_err();
+        assert!(err.to_string().contains("did not write it"), "{err}");
+        check_overwrite(&scan, &[&scan], Some("brtf synth"), true).unwrap();
+        std::fs::write(&scan, b"#generated by brtf 0.1.0 synth").unwrap();
+        check_overwrite(&scan, &[], Some("brtf 0.1.0 synth"), false).unwrap();
+        check_overwrite(&root.path().join("new.mpc"), &[&scan], None, false).unwrap();
     }
 
     #[test]

@@ -16,7 +16,7 @@
 mod folder;
 mod outputs;
 
-pub use folder::{FolderUpdate, leftovers};
+pub use folder::{FolderUpdate, check_overwrite, check_replaceable, leftovers};
 pub use outputs::{OutputFile, Producer, describe_outputs, folder_files, replace_outputs};
 use sha2::{Digest, Sha256};
 use std::io::Write;
@@ -39,11 +39,9 @@ impl std::fmt::Display for IoError {
     }
 }
 
-impl std::error::Error for IoError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        Some(&self.source)
-    }
-}
+// No `source()`: the message already ends with the system's reason, and
+// anyhow's `{:#}` would print it twice.
+impl std::error::Error for IoError {}
 
 /// Creates `dir` and its parents when missing.
 pub fn ensure_folder(dir: &Path) -> Result<(), IoError> {

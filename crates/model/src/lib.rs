@@ -35,8 +35,10 @@ pub mod rng;
 pub use albedo::{Albedo, albedo, gauss_legendre_rule};
 pub use bsdf::{Bsdf, Geometry, Gradient, Rgb, ViewSplit};
 pub use kind::{MaterialKind, Variant};
-pub use material::{FTINY, MAX_ARGS, Material, ModelError};
-pub use options::{EvalOptions, FRESNEL_K_CLASSIC, FRESNEL_K_PYRADIANCE};
+pub use material::{FTINY, MAX_ARGS, Material, ModelError, check_args};
+pub use options::{
+    EvalOptions, FRESNEL_K_CLASSIC, FRESNEL_K_PYRADIANCE, OptionError, check_incidence,
+};
 pub use rng::Rng;
 
 use glam::DVec3;

@@ -132,3 +132,41 @@ impl Material {
         self.args[3]
     }
 }
+
+/// Checks the real arguments of a material read from a file: none
+/// negative, and `spec`, `trans` and `tspec` (fractions) at most 1.
+/// Returns the first problem, naming the argument, for a located error.
+pub fn check_args(kind: MaterialKind, args: &[f64]) -> Result<(), String> {
+    for (name, &value) in kind.param_names().iter().zip(args) {
+        if value < 0.0 {
+            return Err(format!("{name} is {value}; it must not be negative"));
+        }
+        if matches!(*name, "spec" | "trans" | "tspec") && value > 1.0 {
+            return Err(format!("{name} is {value}; it is a fraction, at most 1"));
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod check_args_tests {
+    use super::*;
+
+    #[test]
+    fn negative_and_above_one_fractions_are_named() {
+        assert_eq!(
+            check_args(MaterialKind::Plastic, &[0.5, 0.5, 0.5, 0.05, 0.1]),
+            Ok(())
+        );
+        let err = check_args(MaterialKind::Plastic, &[0.5, 0.5, 0.5, 0.05, -0.1]).unwrap_err();
+        assert_eq!(err, "rough is -0.1; it must not be negative");
+        let err = check_args(MaterialKind::Metal, &[0.5, 0.5, 0.5, 1.5, 0.1]).unwrap_err();
+        assert!(err.starts_with("spec is 1.5"), "{err}");
+        let args = [0.5, 0.5, 0.5, 0.0, 0.1, 1.2, 0.0];
+        assert!(
+            check_args(MaterialKind::Trans, &args)
+                .unwrap_err()
+                .starts_with("trans is 1.2")
+        );
+    }
+}

@@ -48,3 +48,116 @@ impl EvalOptions {
         }
     }
 }
+
+/// A number outside its allowed range, for a one-line error that names
+/// the option, the value and the range:
+/// `--source-omega 100: out of range; allowed: 0 ≤ ω ≤ 2π sr`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct OptionError {
+    /// The option (its command-line spelling).
+    pub option: &'static str,
+    /// The value given, as text.
+    pub value: String,
+    /// The allowed range, for people.
+    pub allowed: &'static str,
+}
+
+impl std::fmt::Display for OptionError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} {}: out of range; allowed: {}",
+            self.option, self.value, self.allowed
+        )
+    }
+}
+
+impl std::error::Error for OptionError {}
+
+impl OptionError {
+    /// `Ok` when `ok`, else the error for `option` = `value`.
+    pub fn check(
+        option: &'static str,
+        value: f64,
+        ok: bool,
+        allowed: &'static str,
+    ) -> Result<(), OptionError> {
+        if ok {
+            return Ok(());
+        }
+        Err(OptionError {
+            option,
+            value: value.to_string(),
+            allowed,
+        })
+    }
+}
+
+impl EvalOptions {
+    /// Checks the settings a user gives: `--fresnel-k` in [0, 1),
+    /// `--source-omega` in [0, 2π] sr (at most a hemisphere), the jitter
+    /// in [0, 1]. NaN fails every check.
+    pub fn validate(&self) -> Result<(), OptionError> {
+        let k = self.fresnel_k;
+        OptionError::check("--fresnel-k", k, (0.0..1.0).contains(&k), "0 ≤ K < 1")?;
+        let omega = self.source_omega;
+        OptionError::check(
+            "--source-omega",
+            omega,
+            (0.0..=std::f64::consts::TAU).contains(&omega),
+            "0 ≤ ω ≤ 2π sr (6.283)",
+        )?;
+        let dj = self.source_jitter;
+        OptionError::check("source jitter", dj, (0.0..=1.0).contains(&dj), "0 to 1")
+    }
+}
+
+/// Checks an incidence given by a user: θ_in in [0, 180]° but not 90°
+/// (grazing light has no irradiance), φ_in finite.
+pub fn check_incidence(theta_in: f64, phi_in: f64) -> Result<(), OptionError> {
+    OptionError::check(
+        "--theta-in",
+        theta_in,
+        (0.0..=180.0).contains(&theta_in) && theta_in != 90.0,
+        "0 ≤ θ_in ≤ 180 degrees, not 90 (grazing)",
+    )?;
+    OptionError::check(
+        "--phi-in",
+        phi_in,
+        phi_in.is_finite(),
+        "a finite angle in degrees",
+    )
+}
+
+#[cfg(test)]
+mod validation_tests {
+    use super::*;
+
+    #[test]
+    fn out_of_range_settings_name_option_value_and_range() {
+        assert_eq!(EvalOptions::default().validate(), Ok(()));
+        let bad = EvalOptions {
+            source_omega: 100.0,
+            ..EvalOptions::default()
+        };
+        assert_eq!(
+            bad.validate().unwrap_err().to_string(),
+            "--source-omega 100: out of range; allowed: 0 ≤ ω ≤ 2π sr (6.283)"
+        );
+        let nan_k = EvalOptions {
+            fresnel_k: f64::NAN,
+            ..EvalOptions::default()
+        };
+        assert!(
+            nan_k
+                .validate()
+                .unwrap_err()
+                .to_string()
+                .contains("--fresnel-k NaN")
+        );
+        assert!(check_incidence(90.0, 0.0).is_err());
+        assert!(check_incidence(f64::NAN, 0.0).is_err());
+        assert!(check_incidence(30.0, f64::INFINITY).is_err());
+        assert_eq!(check_incidence(120.0, -45.0), Ok(()));
+    }
+}

@@ -13,6 +13,6 @@ pub mod export;
 mod primitive;
 
 pub use primitive::{
-    Primitive, RadError, format_primitive, material_from_primitive, parse_primitives,
+    Primitive, RadError, format_primitive, identifier, material_from_primitive, parse_primitives,
     primitive_from_material, select_material,
 };

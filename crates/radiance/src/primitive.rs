@@ -208,6 +208,20 @@ pub fn parse_primitives(text: &str, path: &str) -> Result<Vec<Primitive>, RadErr
             return Err(cursor.error(kind_token.line, format!("unknown primitive type `{kind}`")));
         }
         let name = cursor.next("an identifier", &context)?.text.to_string();
+        if kind == "alias" {
+            // `modifier alias name reference`: no argument lists.
+            let reference = cursor.next("the aliased identifier", &context)?;
+            primitives.push(Primitive {
+                modifier,
+                kind,
+                name,
+                strings: vec![reference.text.to_string()],
+                ints: Vec::new(),
+                reals: Vec::new(),
+                line: start,
+            });
+            continue;
+        }
         let strings = cursor
             .list(&name, "string")?
             .iter()
@@ -304,6 +318,7 @@ pub fn material_from_primitive(p: &Primitive, path: &str) -> Result<Material, Ra
             p.reals.len()
         )));
     }
+    brtf_model::check_args(kind, &p.reals).map_err(|e| err(format!("{kind} `{}`: {e}", p.name)))?;
     Material::new(kind, &p.reals, orientation).map_err(|e| err(format!("{kind} `{}`: {e}", p.name)))
 }
 
@@ -314,6 +329,9 @@ pub fn select_material(
     path: &str,
 ) -> Result<(String, Material), RadError> {
     let is_ward = |p: &&Primitive| p.kind.parse::<MaterialKind>().is_ok();
+    let is_theta_export = |p: &&Primitive| {
+        p.kind == "BRTDfunc" && p.strings.iter().any(|s| s.ends_with("-theta.cal"))
+    };
     let chosen = match name {
         Some(name) => primitives
             .iter()
@@ -328,10 +346,23 @@ pub fn select_material(
             match candidates.as_slice() {
                 [one] => *one,
                 [] => {
+                    let theta = primitives.iter().find(is_theta_export);
                     return Err(RadError {
                         path: path.to_string(),
-                        line: 1,
-                        message: "no plastic, metal, trans, plastic2, metal2 or trans2 material in the file".into(),
+                        line: theta.map_or(1, |p| p.line),
+                        message: match theta {
+                            Some(p) => format!(
+                                "`{}` is brtf's θ_in-dependent export (a BRTDfunc), which brtf \
+                                 cannot evaluate; use the static material beside it ({}.rad) \
+                                 (`brtf render --fit DIR` renders the θ_in-dependent fit)",
+                                p.name, p.name
+                            ),
+                            None => {
+                                "no plastic, metal, trans, plastic2, metal2 or trans2 material \
+                                     in the file"
+                                    .into()
+                            }
+                        },
                     });
                 }
                 many => {
@@ -348,7 +379,38 @@ pub fn select_material(
             }
         }
     };
-    Ok((chosen.name.clone(), material_from_primitive(chosen, path)?))
+    // `void alias new old`: the material of `old`, under the name asked for.
+    let mut target = chosen;
+    for _ in 0..primitives.len() {
+        if target.kind != "alias" {
+            break;
+        }
+        let reference = &target.strings[0];
+        target = primitives
+            .iter()
+            .find(|p| &p.name == reference && p.line < target.line)
+            .ok_or_else(|| RadError {
+                path: path.to_string(),
+                line: target.line,
+                message: format!(
+                    "alias `{}`: no material `{reference}` before it",
+                    target.name
+                ),
+            })?;
+    }
+    Ok((chosen.name.clone(), material_from_primitive(target, path)?))
+}
+
+/// `text` made a Radiance identifier that is also a safe file stem: ASCII
+/// letters, digits, `_`, `-` and `.`, others replaced by `_`, not starting
+/// with `-` or `.`, without trailing `_`. `None` when nothing is left.
+pub fn identifier(text: &str) -> Option<String> {
+    let ok = |c: char| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.');
+    let mapped: String = text.chars().map(|c| if ok(c) { c } else { '_' }).collect();
+    let trimmed = mapped
+        .trim_start_matches(['-', '.', '_'])
+        .trim_end_matches(['_', '-', '.']);
+    (!trimmed.is_empty()).then(|| trimmed.to_string())
 }
 
 /// The primitive `void <type> <name>` for a material.

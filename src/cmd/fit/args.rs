@@ -16,16 +16,19 @@ pub struct FitArgs {
     /// Measurement files, one incidence each (.mpc or pab-opto Mountain).
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
-    /// Model to fit.
+    /// Model to fit: plastic, metal, trans, plastic2, metal2 or trans2.
     #[arg(long, value_parser = parse_kind)]
     pub model: MaterialKind,
     /// Tie R = G = B (always so for single-channel data).
     #[arg(long)]
     pub gray: bool,
-    /// Output folder [default: fits/<name>].
+    /// Output folder, replaced as a whole [default: fits/<name>].
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Material name [default: the files' folder name].
+    /// Replace an output folder that holds another fit or other files.
+    #[arg(long)]
+    pub force: bool,
+    /// Material name [default: the files' #sample_name, else their common file-name stem].
     #[arg(long)]
     pub name: Option<String>,
     /// Formula set: radiance (current rtrace), manual2004 or ward1992.

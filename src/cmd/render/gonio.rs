@@ -63,6 +63,9 @@ pub struct GonioArgs {
     /// Worker threads [default: all cores].
     #[arg(long)]
     pub jobs: Option<usize>,
+    /// Overwrite --out even when it is the --like or --material file.
+    #[arg(long)]
+    pub force: bool,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, ValueEnum)]
@@ -87,6 +90,12 @@ pub fn run(args: GonioArgs) -> Result<()> {
         .phi_in
         .or(like.as_ref().map(|m| m.incidence.phi_deg))
         .unwrap_or(0.0);
+    brtf_model::check_incidence(theta_in, phi_in)?;
+    if let Some(out) = &args.out {
+        let inputs = [&args.like, &args.sample.material];
+        let inputs: Vec<&std::path::Path> = inputs.iter().filter_map(|p| p.as_deref()).collect();
+        brtf_io::check_overwrite(out, &inputs, None, args.force)?;
+    }
     let fit_omega = loaded.fit.as_ref().map(|f| f.options().source_omega);
     let source_omega = aperture_solid_angle(Aperture::Source, args.source_omega, args.source_apex)?
         .or(fit_omega)

@@ -170,6 +170,11 @@ impl ImageArgs {
 pub fn run(args: ImageArgs) -> Result<()> {
     let spec = args.spec();
     spec.validate()?;
+    for ext in [".hdr", ".png", ".rad", ".vf"] {
+        let inputs: Vec<&std::path::Path> =
+            args.sample.material.iter().map(|m| m.as_path()).collect();
+        brtf_io::check_overwrite(&args.with_ext(ext), &inputs, None, false)?;
+    }
     let loaded = args.sample.load()?;
     let is_table = loaded.shader.is_table();
     let (scene, camera) = spec.build(loaded.shader)?;
