@@ -71,6 +71,7 @@ fn report(kind: MaterialKind, theta_in: f64, args: &[f64]) -> FitReport {
         elapsed_ms: 1.0,
         starts: Vec::new(),
         warnings: Vec::new(),
+        adequacy: None,
     }
 }
 

@@ -330,6 +330,7 @@ impl Reported<'_> {
             elapsed_ms: self.started.elapsed().as_secs_f64() * 1e3,
             starts: self.records,
             warnings,
+            adequacy: None,
         })
     }
 }

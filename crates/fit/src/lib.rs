@@ -31,6 +31,7 @@
 
 mod config;
 mod data;
+mod diagnose;
 mod fitter;
 mod params;
 mod prepare;
@@ -65,6 +66,9 @@ pub(crate) mod serde_kind {
 pub use brtf_gonio::Gate;
 pub use config::{FitConfig, FitError, RobustLoss};
 pub use data::{FitSample, GateCount, IncidenceData, Weighting};
+pub use diagnose::{
+    Adequacy, ENERGY_TOLERANCE, PEAK_TOLERANCE_DEG, RESIDUAL_KIND_TOLERANCE, ResidualCheck,
+};
 pub use fitter::{fit_global, fit_incidence};
 pub use params::{MAX_ROUGHNESS, MIN_ROUGHNESS, ParamMap, Slot, Target};
 pub use problem::ResidualKind;

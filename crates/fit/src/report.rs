@@ -167,6 +167,9 @@ pub struct FitReport {
     pub starts: Vec<StartRecord>,
     /// Things the user should know (bounds, degenerate lobes, ...).
     pub warnings: Vec<FitWarning>,
+    /// Whether the model describes the data (made by [`crate::fit_set`]).
+    #[serde(default)]
+    pub adequacy: Option<crate::diagnose::Adequacy>,
 }
 
 impl FitReport {
@@ -225,6 +228,23 @@ pub enum FitWarning {
         /// Why it stopped.
         termination: Termination,
     },
+    /// The data's ρ_dh (or τ_dh) and the model's differ by more than 5%.
+    EnergyMismatch {
+        /// The data's.
+        data: f64,
+        /// The model's.
+        model: f64,
+    },
+    /// The model's peak is more than 5° from the data's.
+    PeakOffset {
+        /// The angle between them.
+        degrees: f64,
+    },
+    /// A parameter moves by more than 20% with another residual kind.
+    ResidualKindSensitive {
+        /// The comparison.
+        check: crate::diagnose::ResidualCheck,
+    },
 }
 
 impl std::fmt::Display for FitWarning {
@@ -256,6 +276,27 @@ impl std::fmt::Display for FitWarning {
             FitWarning::NotConverged { termination } => {
                 write!(f, "optimiser stopped without converging: {termination:?}")
             }
+            FitWarning::EnergyMismatch { data, model } => write!(
+                f,
+                "the model does not carry the data's energy: data ρ_dh {data:.4}, model {model:.4} \
+                 ({:+.1}%); the model cannot describe this sample's scattering",
+                100.0 * (model / data - 1.0)
+            ),
+            FitWarning::PeakOffset { degrees } => write!(
+                f,
+                "the model's peak is {degrees:.1}° from the data's: the lobe is in the wrong place"
+            ),
+            FitWarning::ResidualKindSensitive { check } => write!(
+                f,
+                "{} moves from {:.4} to {:.4} ({:.0}%) when fitted with {:?} residuals: \
+                 the parameters depend on how the misfit is weighed, so the model does not \
+                 describe the data",
+                check.param,
+                check.values[0],
+                check.values[1],
+                100.0 * check.relative_change,
+                check.residual
+            ),
         }
     }
 }

@@ -255,6 +255,8 @@ impl FitResult {
         header.extend(names.iter().map(|n| n.to_string()));
         header.extend(names.iter().map(|n| format!("{n}_stderr")));
         header.extend(["rms_rel".into(), "cost".into(), "termination".into()]);
+        // The adequacy columns follow the contract's (empty without them).
+        header.extend(["rho_dh_data".into(), "rho_dh_model".into()]);
         w.write_record(&header)?;
         let row = |r: &FitReport, theta: String, phi: String| -> Vec<String> {
             let mut v = vec![theta, phi, r.n_points.to_string()];
@@ -270,6 +272,10 @@ impl FitResult {
                 format!("{:.6e}", r.cost),
                 r.termination.label().into(),
             ]);
+            let adequacy = r.adequacy.as_ref();
+            let number = |x: Option<f64>| x.map_or_else(String::new, |v| format!("{v:.6}"));
+            v.push(number(adequacy.and_then(|a| a.rho_data)));
+            v.push(number(adequacy.map(|a| a.rho_model)));
             v
         };
         for r in &self.incidences {

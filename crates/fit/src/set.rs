@@ -4,6 +4,7 @@
 
 use crate::config::{FitConfig, FitError};
 use crate::data::IncidenceData;
+use crate::diagnose;
 use crate::fitter::{fit_global, fit_incidence};
 use crate::recipe::{PreparedMeasurement, Recipe, RecipeError, ScaleRule};
 use crate::report::FitReport;
@@ -44,6 +45,9 @@ pub struct FitSetOptions {
     pub interpolation: Interpolation,
     /// The command line, for the provenance.
     pub command_line: Vec<String>,
+    /// Judge each incidence's fit (energy, peak, a second fit with another
+    /// residual kind; see [`crate::Adequacy`]).
+    pub adequacy: bool,
 }
 
 /// Why a fit set could not be made.
@@ -116,28 +120,28 @@ pub fn fit_set(
     let mut warnings = Vec::new();
     let (mut reports, mut global) = fit_all(&inputs, &config, progress)?;
 
-    // A known reflectance turns a free-scale fit absolute: the fitted model's
-    // ρ_dh at that incidence fixes the instrument's scale K; the data are
+    // A known reflectance turns a free-scale fit absolute: the data's own
+    // ρ_dh at that incidence (measured directions from the data, the rest
+    // from the free-scale fit) fixes the instrument's scale K; the data are
     // divided by K and fitted again without a free scale.
     if let Some((rho, theta)) = options.known_reflectance {
         if free_count == 0 {
             return Err(FitSetError::KnownReflectanceOnAbsoluteData);
         }
-        let nearest = reports
-            .iter()
-            .min_by(|a, b| {
-                (a.theta_in - theta)
+        let nearest = (0..reports.len())
+            .min_by(|&a, &b| {
+                (reports[a].theta_in - theta)
                     .abs()
-                    .total_cmp(&(b.theta_in - theta).abs())
+                    .total_cmp(&(reports[b].theta_in - theta).abs())
             })
             .expect("at least one incidence");
-        if (nearest.theta_in - theta).abs() > 5.0 {
+        if (reports[nearest].theta_in - theta).abs() > 5.0 {
             warnings.push(SetWarning::RhoFarFromIncidence {
                 requested: theta,
-                used: nearest.theta_in,
+                used: reports[nearest].theta_in,
             });
         }
-        let k = instrument_scale(&config, nearest, rho, theta)?;
+        let k = instrument_scale(&config, &inputs[nearest].prepared, &reports[nearest], rho)?;
         for input in &mut inputs {
             input.prepared.rescale_known_reflectance(k, rho, theta);
             input.file.conversion = input.prepared.conversion.clone();
@@ -149,6 +153,10 @@ pub fn fit_set(
         };
         config.free_scale = false;
         (reports, global) = fit_all(&inputs, &config, progress)?;
+    }
+
+    if options.adequacy {
+        assess(&inputs, &mut reports, &config, progress)?;
     }
 
     let table = match ParamTable::from_reports(
@@ -209,13 +217,14 @@ fn read_input(path: &Path, recipe: &Recipe) -> Result<Input, FitSetError> {
     })
 }
 
-/// K such that the data ÷ K have the reflectance `rho` at `theta`, from the
-/// free-scale fit `report` of the nearest incidence.
+/// K such that the data ÷ K have the reflectance `rho` at their incidence:
+/// the data's own raw-unit ρ_dh (measured directions from the data, the
+/// unmeasured rest from the free-scale fit `report`) ÷ `rho`.
 fn instrument_scale(
     config: &FitConfig,
+    prepared: &PreparedMeasurement,
     report: &FitReport,
     rho: f64,
-    theta: f64,
 ) -> Result<f64, FitSetError> {
     let material = brtf_model::Material::new(
         config.kind,
@@ -229,14 +238,48 @@ fn instrument_scale(
         })
     })?;
     let bsdf = brtf_model::Bsdf::new(&material, &config.options);
-    let albedo = brtf_model::albedo(&bsdf, brtf_model::direction(theta, report.phi_in), 1e-6);
-    let model_rho = report.scale * (albedo.rho.iter().sum::<f64>() / 3.0);
-    let k = model_rho / rho;
+    let (rho_model, _) = diagnose::model_albedo(prepared, &bsdf);
+    let measured = diagnose::measured_integrals(prepared, &bsdf, report.scale);
+    let (data, model) = measured.front.unwrap_or((0.0, 0.0));
+    let k = (data + report.scale * rho_model - model) / rho;
     if k.is_finite() && k > 0.0 {
         Ok(k)
     } else {
-        Err(FitSetError::NoReflectance(theta))
+        Err(FitSetError::NoReflectance(report.theta_in))
     }
+}
+
+/// The adequacy diagnostics of every incidence, with the fit made again
+/// with another residual kind, and their warnings.
+fn assess(
+    inputs: &[Input],
+    reports: &mut [FitReport],
+    config: &FitConfig,
+    progress: &dyn Progress,
+) -> Result<(), FitSetError> {
+    let other = diagnose::other_residual(config.residual);
+    let mut other_config = config.clone();
+    other_config.residual = other;
+    other_config.loss = crate::RobustLoss::None;
+    progress.begin(inputs.len() as u64);
+    let others: Vec<Option<FitReport>> = inputs
+        .par_iter()
+        .map(|i| {
+            let r = fit_incidence(&i.prepared.incidence_data(), &other_config).ok();
+            progress.advance();
+            r
+        })
+        .collect();
+    progress.end();
+    for ((input, report), other_fit) in inputs.iter().zip(reports.iter_mut()).zip(others) {
+        let Some(mut adequacy) = diagnose::diagnose(&input.prepared, report, config) else {
+            continue;
+        };
+        adequacy.residual_check = other_fit.and_then(|o| diagnose::compare(report, &o, other));
+        report.warnings.extend(diagnose::warnings(&adequacy));
+        report.adequacy = Some(adequacy);
+    }
+    Ok(())
 }
 
 /// Fits every incidence and all of them at once, in parallel.

@@ -50,8 +50,12 @@ pub fn summary(result: &FitResult, out: &Path) -> String {
                 (Some(e), _) => {
                     let _ = write!(s, " {:>8.5}±{:<7.1e}{}", p.value, e, flag);
                 }
+                // A held parameter says so with its flag alone.
+                (None, Some("fixed")) => {
+                    let _ = write!(s, " {:>8.5} {:<7}{}", p.value, "", flag);
+                }
                 (None, reason) => {
-                    let _ = write!(s, " {:>8.5} {:<8}{}", p.value, reason.unwrap_or(""), flag);
+                    let _ = write!(s, " {:>8.5} {:<7}{}", p.value, reason.unwrap_or(""), flag);
                 }
             }
         }
@@ -68,6 +72,7 @@ pub fn summary(result: &FitResult, out: &Path) -> String {
         line("all".into(), g);
     }
     let _ = writeln!(s, "(! = at a bound, = = held fixed)");
+    adequacy_table(&mut s, result);
     let global = result.global.iter().filter(|_| result.incidences.len() > 1);
     let labelled = result
         .incidences
@@ -95,4 +100,59 @@ pub fn summary(result: &FitResult, out: &Path) -> String {
         );
     }
     s
+}
+
+/// The adequacy diagnostics, one line per incidence that has them.
+fn adequacy_table(s: &mut String, result: &FitResult) {
+    let rows: Vec<(&FitReport, &crate::Adequacy)> = result
+        .incidences
+        .iter()
+        .filter_map(|r| r.adequacy.as_ref().map(|a| (r, a)))
+        .collect();
+    if rows.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        s,
+        "\nadequacy (warns beyond ±{:.0}% energy, {:.0}° peak offset, {:.0}% parameter change):",
+        100.0 * crate::ENERGY_TOLERANCE,
+        crate::PEAK_TOLERANCE_DEG,
+        100.0 * crate::RESIDUAL_KIND_TOLERANCE
+    );
+    let _ = writeln!(
+        s,
+        "{:>8} {:>10} {:>10} {:>7} {:>6}  other residual kind",
+        "θ_in", "data ρ/τ", "model ρ/τ", "ratio", "peak°"
+    );
+    let opt = |x: Option<f64>, width: usize, precision: usize| {
+        x.map_or_else(
+            || format!("{:>width$}", "–"),
+            |v| format!("{v:>width$.precision$}"),
+        )
+    };
+    for (r, a) in rows {
+        let (data, model) = match a.rho_data {
+            Some(d) => (Some(d), a.rho_model),
+            None => (a.tau_data, a.tau_model),
+        };
+        let check = a.residual_check.as_ref().map_or_else(String::new, |c| {
+            format!(
+                "{:?}: {} {:.4} → {:.4} ({:.0}%)",
+                c.residual,
+                c.param,
+                c.values[0],
+                c.values[1],
+                100.0 * c.relative_change
+            )
+        });
+        let _ = writeln!(
+            s,
+            "{:>8} {} {:>10.4} {} {}  {check}",
+            r.theta_in,
+            opt(data, 10, 4),
+            model,
+            opt(a.energy_ratio(), 7, 3),
+            opt(a.peak_offset_deg, 6, 1),
+        );
+    }
 }

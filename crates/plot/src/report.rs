@@ -401,6 +401,9 @@ pub fn html(input: &ReportInput) -> String {
             let _ = write!(out, "; selections: {}", gates.join(", "));
         }
         out.push_str(".</p>\n");
+        if let Some(a) = &r.adequacy {
+            adequacy_line(&mut out, a);
+        }
         match &entry.data {
             Err(why) => {
                 let _ = writeln!(out, "<p class=\"warn\">No map or cut: {}</p>", esc(why));
@@ -427,6 +430,57 @@ pub fn html(input: &ReportInput) -> String {
     provenance_section(&mut out, input.dir, result);
     out.push_str("</section>\n</body>\n</html>\n");
     out
+}
+
+/// One incidence's adequacy diagnostics (see `docs/fitting.md`, "When not
+/// to trust a fit"), each figure marked when it is past its threshold.
+fn adequacy_line(out: &mut String, a: &brtf_fit::Adequacy) {
+    let mark = |bad: bool, text: String| {
+        if bad {
+            format!("<span class=\"bound\">{text}</span>")
+        } else {
+            text
+        }
+    };
+    let mut parts = Vec::new();
+    let (label, data, model) = match a.rho_data {
+        Some(d) => ("ρ_dh", Some(d), a.rho_model),
+        None => ("τ_dh", a.tau_data, a.tau_model),
+    };
+    if let (Some(d), Some(ratio)) = (data, a.energy_ratio()) {
+        let tolerance = brtf_fit::ENERGY_TOLERANCE;
+        let bad = !(1.0 / (1.0 + tolerance)..=1.0 + tolerance).contains(&ratio);
+        parts.push(mark(
+            bad,
+            format!("{label} data {d:.4}, model {model:.4} (ratio {ratio:.3})"),
+        ));
+    }
+    if let Some(p) = a.peak_offset_deg {
+        parts.push(mark(
+            p > brtf_fit::PEAK_TOLERANCE_DEG,
+            format!("model peak {p:.1}° from the data's"),
+        ));
+    }
+    if let Some(c) = &a.residual_check {
+        parts.push(mark(
+            c.relative_change > brtf_fit::RESIDUAL_KIND_TOLERANCE,
+            format!(
+                "with {:?} residuals {} {} → {} ({:.0}%)",
+                c.residual,
+                esc(&c.param),
+                fmt(c.values[0]),
+                fmt(c.values[1]),
+                100.0 * c.relative_change
+            ),
+        ));
+    }
+    if !parts.is_empty() {
+        let _ = writeln!(
+            out,
+            "<p class=\"adequacy\">Adequacy: {}.</p>",
+            parts.join("; ")
+        );
+    }
 }
 
 #[cfg(test)]

@@ -45,6 +45,7 @@ fn report(kind: MaterialKind, theta_in: f64, args: &[f64]) -> FitReport {
         elapsed_ms: 12.0,
         starts: Vec::new(),
         warnings: Vec::new(),
+        adequacy: None,
     }
 }
 

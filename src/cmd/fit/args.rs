@@ -92,6 +92,10 @@ pub struct FitArgs {
     /// θ_in interpolation of the parameters.
     #[arg(long, value_enum, default_value_t = InterpArg::Pchip)]
     pub interpolation: InterpArg,
+    /// Skip the adequacy diagnostics (energy, peak, and the second fit with
+    /// another residual kind).
+    #[arg(long)]
+    pub no_adequacy: bool,
     /// Worker threads [default: all cores].
     #[arg(long)]
     pub jobs: Option<usize>,
@@ -242,6 +246,7 @@ impl FitArgs {
                 InterpArg::Linear => Interpolation::Linear,
             },
             command_line: std::env::args().collect(),
+            adequacy: !self.no_adequacy,
         })
     }
 }

@@ -1,0 +1,275 @@
+//! Whether a fitted model describes its data: energy, peak direction and
+//! sensitivity to the residual kind, per incidence. A low cost does not
+//! say the model is right; these say where it is not.
+//!
+//! * **Energy.** The data's directional-hemispherical reflectance (and
+//!   transmittance) against the model's: over the measured directions from
+//!   the data (Σ y |cos θ| ΔΩ over the fitted samples), the unmeasured rest
+//!   from the model, so that a model that fits every measured sample has
+//!   the data's ρ_dh exactly.
+//! * **Peak.** The direction of the data's brightest samples against the
+//!   model's, over the same fitted directions.
+//! * **Residual kind.** The parameters fitted again with another residual
+//!   kind (absolute ↔ log): a model that describes the data gives about the
+//!   same parameters whichever way the misfit is weighed.
+//!
+//! Colour data are judged on their luminance (CIE Y), grey data as they are.
+
+use crate::config::FitConfig;
+use crate::recipe::PreparedMeasurement;
+use crate::report::FitReport;
+use brtf_gonio::Hemisphere;
+use brtf_model::{Bsdf, Material};
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+
+/// Energy ratio (data ÷ model) outside [1/(1+t), 1+t] warns.
+pub const ENERGY_TOLERANCE: f64 = 0.05;
+/// A model peak farther than this from the data's warns, degrees.
+pub const PEAK_TOLERANCE_DEG: f64 = 5.0;
+/// A parameter that moves by more than this fraction between residual
+/// kinds warns.
+pub const RESIDUAL_KIND_TOLERANCE: f64 = 0.2;
+/// The brightest fraction of the fitted samples whose centroid is the peak.
+const PEAK_FRACTION: f64 = 0.002;
+
+/// The adequacy diagnostics of one incidence.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Adequacy {
+    /// The data's ρ_dh (front), measured part plus the model's for the
+    /// unmeasured directions; `None` without fitted front samples.
+    pub rho_data: Option<f64>,
+    /// The model's ρ_dh.
+    pub rho_model: f64,
+    /// The data's τ_dh (back), as `rho_data`; `None` without back samples.
+    pub tau_data: Option<f64>,
+    /// The model's τ_dh.
+    pub tau_model: f64,
+    /// Angle between the data's and the model's peak directions, degrees
+    /// (`None` when the data have no distinct peak).
+    pub peak_offset_deg: Option<f64>,
+    /// The fit with the other residual kind, when it was made.
+    pub residual_check: Option<ResidualCheck>,
+}
+
+impl Adequacy {
+    /// Data ÷ model reflectance (or transmittance when there is no
+    /// reflection data).
+    pub fn energy_ratio(&self) -> Option<f64> {
+        match (self.rho_data, self.tau_data) {
+            (Some(d), _) if self.rho_model > 0.0 => Some(d / self.rho_model),
+            (_, Some(d)) if self.tau_model > 0.0 => Some(d / self.tau_model),
+            _ => None,
+        }
+    }
+}
+
+/// The parameters fitted with another residual kind.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ResidualCheck {
+    /// The other residual kind.
+    pub residual: crate::ResidualKind,
+    /// The parameter that moved most.
+    pub param: String,
+    /// Its value in the main fit and in the other one.
+    pub values: [f64; 2],
+    /// |difference| ÷ the larger magnitude.
+    pub relative_change: f64,
+}
+
+/// The material of `report` with `config`'s orientation.
+fn material(config: &FitConfig, report: &FitReport) -> Option<Material> {
+    Material::new(
+        config.kind,
+        &report.material_args,
+        Some(DVec3::from_array(config.orientation)),
+    )
+    .ok()
+}
+
+/// Luminance of the used channels of `values` (grey: the value itself).
+fn luminance(values: [f64; 3], channels: usize) -> f64 {
+    if channels >= 3 {
+        brtf_model::colour::luminance(values)
+    } else {
+        values[0]
+    }
+}
+
+/// Hemispherical integrals of data and model over the fitted samples of
+/// `prepared`, in the data's unit: `(data, model)` per hemisphere.
+pub(crate) struct Measured {
+    pub front: Option<(f64, f64)>,
+    pub back: Option<(f64, f64)>,
+}
+
+/// Σ y |cos θ| ΔΩ and Σ scale·f |cos θ| ΔΩ over the fitted samples.
+pub(crate) fn measured_integrals(
+    prepared: &PreparedMeasurement,
+    bsdf: &Bsdf,
+    scale: f64,
+) -> Measured {
+    let channels = prepared.channels();
+    let light = prepared.measurement.incident_direction();
+    let mut sums = [[0.0; 2]; 2];
+    let mut seen = [false; 2];
+    for (_, s) in prepared.fitted() {
+        let weight = s.solid_angle_sr.unwrap_or(0.0) * s.abs_cos_theta();
+        let side = usize::from(s.hemisphere() == Hemisphere::Back);
+        let f = bsdf.eval(light, s.direction());
+        sums[side][0] += weight * luminance(s.values, channels);
+        sums[side][1] += weight * scale * luminance(f, channels);
+        seen[side] = true;
+    }
+    let pick = |side: usize| seen[side].then_some((sums[side][0], sums[side][1]));
+    Measured {
+        front: pick(0),
+        back: pick(1),
+    }
+}
+
+/// The model's ρ_dh and τ_dh at the incidence of `prepared`, in luminance.
+pub(crate) fn model_albedo(prepared: &PreparedMeasurement, bsdf: &Bsdf) -> (f64, f64) {
+    let channels = prepared.channels();
+    let a = brtf_model::albedo(bsdf, prepared.measurement.incident_direction(), 1e-6);
+    let total =
+        |x: [f64; 3], spike: [f64; 3]| luminance([0, 1, 2].map(|c| x[c] + spike[c]), channels);
+    (total(a.rho, a.rho_spike), total(a.tau, a.tau_spike))
+}
+
+/// The energy and peak diagnostics of `report`, fitted to `prepared`
+/// (the residual-kind check is added by the caller).
+pub(crate) fn diagnose(
+    prepared: &PreparedMeasurement,
+    report: &FitReport,
+    config: &FitConfig,
+) -> Option<Adequacy> {
+    let material = material(config, report)?;
+    let bsdf = Bsdf::new(&material, &config.options);
+    let scale = report.scale;
+    let (rho_model, tau_model) = model_albedo(prepared, &bsdf);
+    let measured = measured_integrals(prepared, &bsdf, scale);
+    // Data's reflectance: measured part ÷ scale, plus the model's rest.
+    let complete = |part: Option<(f64, f64)>, model_total: f64| {
+        part.map(|(data, model)| model_total + (data - model) / scale)
+    };
+    Some(Adequacy {
+        rho_data: complete(measured.front, rho_model),
+        rho_model,
+        tau_data: complete(measured.back, tau_model),
+        tau_model,
+        peak_offset_deg: peak_offset(prepared, &bsdf),
+        residual_check: None,
+    })
+}
+
+/// Angle between the centroids of the brightest data and model samples,
+/// over the fitted directions of the hemisphere that holds the brightest
+/// data sample. `None` when the data have no distinct peak (their
+/// brightest samples are less than twice their median).
+fn peak_offset(prepared: &PreparedMeasurement, bsdf: &Bsdf) -> Option<f64> {
+    let channels = prepared.channels();
+    let light = prepared.measurement.incident_direction();
+    let samples: Vec<(DVec3, f64, f64)> = prepared
+        .fitted()
+        .map(|(_, s)| {
+            let v = s.direction();
+            let y = luminance(s.values, channels);
+            (v, y, luminance(bsdf.eval(light, v), channels))
+        })
+        .filter(|(_, y, _)| y.is_finite())
+        .collect();
+    if samples.len() < 10 {
+        return None;
+    }
+    let count = ((samples.len() as f64 * PEAK_FRACTION).ceil() as usize).clamp(3, samples.len());
+    let centroid = |value: &dyn Fn(&(DVec3, f64, f64)) -> f64| -> (DVec3, f64) {
+        let mut order: Vec<usize> = (0..samples.len()).collect();
+        order.sort_by(|&a, &b| value(&samples[b]).total_cmp(&value(&samples[a])));
+        let top = &order[..count];
+        let sum: DVec3 = top
+            .iter()
+            .map(|&i| samples[i].0 * value(&samples[i]).max(0.0))
+            .sum();
+        let mut all: Vec<f64> = samples.iter().map(value).collect();
+        let mid = all.len() / 2;
+        let median = *all.select_nth_unstable_by(mid, f64::total_cmp).1;
+        (
+            sum.normalize_or_zero(),
+            value(&samples[top[0]]) / median.max(1e-300),
+        )
+    };
+    let (data_peak, contrast) = centroid(&|s| s.1);
+    let (model_peak, _) = centroid(&|s| s.2);
+    if contrast < 2.0 || data_peak == DVec3::ZERO || model_peak == DVec3::ZERO {
+        return None;
+    }
+    Some(
+        data_peak
+            .dot(model_peak)
+            .clamp(-1.0, 1.0)
+            .acos()
+            .to_degrees(),
+    )
+}
+
+/// The residual kind of the second fit: log for absolute residuals,
+/// absolute for relative and log ones.
+pub(crate) fn other_residual(kind: crate::ResidualKind) -> crate::ResidualKind {
+    match kind {
+        crate::ResidualKind::Absolute => crate::ResidualKind::Log,
+        _ => crate::ResidualKind::Absolute,
+    }
+}
+
+/// The parameter of `main` that moved most in `other` (fitted with the
+/// residual kind `residual`). Small values are compared on an absolute
+/// floor of 0.02, so that a specularity of 0.001 against 0.003 does not
+/// count as a 200% change.
+pub(crate) fn compare(
+    main: &FitReport,
+    other: &FitReport,
+    residual: crate::ResidualKind,
+) -> Option<ResidualCheck> {
+    main.params
+        .iter()
+        .zip(&other.params)
+        .filter(|(a, _)| !a.fixed && a.name != "scale")
+        .map(|(a, b)| {
+            let change = (a.value - b.value).abs() / a.value.abs().max(b.value.abs()).max(0.02);
+            ResidualCheck {
+                residual,
+                param: a.name.clone(),
+                values: [a.value, b.value],
+                relative_change: change,
+            }
+        })
+        .max_by(|a, b| a.relative_change.total_cmp(&b.relative_change))
+}
+
+/// The warnings the diagnostics call for.
+pub(crate) fn warnings(a: &Adequacy) -> Vec<crate::FitWarning> {
+    let mut warnings = Vec::new();
+    if let Some(ratio) = a.energy_ratio()
+        && !(1.0 / (1.0 + ENERGY_TOLERANCE)..=1.0 + ENERGY_TOLERANCE).contains(&ratio)
+    {
+        let (data, model) = match a.rho_data {
+            Some(d) if a.rho_model > 0.0 => (d, a.rho_model),
+            _ => (a.tau_data.unwrap_or(f64::NAN), a.tau_model),
+        };
+        warnings.push(crate::FitWarning::EnergyMismatch { data, model });
+    }
+    if let Some(offset) = a.peak_offset_deg
+        && offset > PEAK_TOLERANCE_DEG
+    {
+        warnings.push(crate::FitWarning::PeakOffset { degrees: offset });
+    }
+    if let Some(check) = &a.residual_check
+        && check.relative_change > RESIDUAL_KIND_TOLERANCE
+    {
+        warnings.push(crate::FitWarning::ResidualKindSensitive {
+            check: check.clone(),
+        });
+    }
+    warnings
+}
