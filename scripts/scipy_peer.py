@@ -8,7 +8,15 @@ Reads target/fit-bench-metal.csv (written by `cargo bench -p brtf-fit`).
 Alone it prints the median time of several runs and the cost 1/2 sum r^2;
 with `--serve FILE` it fits on request, for the brtf bench (`vs_scipy`,
 run by scripts/bench-fit.sh), which alternates its own fits with these.
+
+With `--objective FILE SETTINGS` it fits any of brtf's objectives for a grey
+metal with a free scale (residual absolute, relative or log, with an
+optional Huber loss: scipy's own `loss="huber"`, `f_scale`) to the samples
+in FILE (`vx,vy,vz,y,w`), and prints scipy's cost at its own optimum and at
+brtf's parameters, as JSON. The CLI test `peer` uses it to check that
+brtf's cost is never above scipy's on the same objective.
 """
+import json
 import sys
 import time
 
@@ -95,7 +103,55 @@ def serve(path):
         print(f"{ms:.3f} {result.cost:.17g} {c:.17g} {rs:.17g} {a:.17g}", flush=True)
 
 
+def objective(path, settings):
+    """scipy on brtf's objective `settings` (see the module docs)."""
+    d = np.loadtxt(path, delimiter=",", skiprows=1)
+    views, y, w = d[:, 0:3], d[:, 3], d[:, 4]
+    light = np.array(settings["light"])
+    floor = settings["floor"]
+    kind = settings["residual"]
+    sw = np.sqrt(w / w.mean())
+    h = views + light
+    hn = h[:, 2]
+    hh = np.einsum("ij,ij->i", h, h)
+    tan2 = (hh - hn * hn) / (hn * hn)
+    norm = hh / (np.pi * hn ** 4)
+    relative = sw / np.sqrt(y * y + floor * floor)
+
+    def residuals(p):
+        m = model(p, tan2, norm)[0]
+        if kind == "absolute":
+            return sw * (m - y)
+        if kind == "relative":
+            return relative * (m - y)
+        return sw * (np.log(m + floor) - np.log(np.maximum(y, 0.0) + floor))
+
+    f_scale = settings.get("huber_f_scale")
+    loss = "huber" if f_scale else "linear"
+    f_scale = f_scale or 1.0
+
+    def cost(p):
+        z = (residuals(np.asarray(p)) / f_scale) ** 2
+        if loss == "huber":
+            z = np.where(z <= 1, z, 2 * np.sqrt(z) - 1)
+        return 0.5 * f_scale ** 2 * z.sum()
+
+    start = settings.get("start", [0.05, 0.5, 0.1])
+    result = least_squares(residuals, start, bounds=([0, 0, 0.002], [np.inf, 1, 1]),
+                           method="trf", loss=loss, f_scale=f_scale,
+                           x_scale="jac", ftol=1e-12, xtol=1e-12, gtol=1e-12, max_nfev=2000)
+    print(json.dumps({
+        "cost_scipy": cost(result.x),
+        "cost_at_brtf": cost(settings["brtf"]),
+        "params_scipy": list(result.x),
+        "nfev": int(result.nfev),
+    }))
+
+
 def main():
+    if len(sys.argv) > 3 and sys.argv[1] == "--objective":
+        objective(sys.argv[2], json.loads(sys.argv[3]))
+        return
     if len(sys.argv) > 2 and sys.argv[1] == "--serve":
         serve(sys.argv[2])
         return

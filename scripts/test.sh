@@ -11,6 +11,11 @@ if ! .venv/bin/python -c "import pyradiance" 2>/dev/null; then
     python3 -m venv .venv
     .venv/bin/pip install --quiet --disable-pip-version-check pyradiance==1.3.1
 fi
+# numpy and scipy for the scipy peer (tests/cli/peer.rs).
+if ! .venv/bin/python -c "import numpy, scipy" 2>/dev/null; then
+    echo "== installing numpy and scipy (the scipy peer) into .venv"
+    .venv/bin/pip install --quiet --disable-pip-version-check numpy scipy
+fi
 pkg=$(.venv/bin/python -c "import os, pyradiance; print(os.path.dirname(pyradiance.__file__))")
 export RADIANCE_BIN="$pkg/bin"
 export RAYPATH=".:$pkg/lib"

@@ -14,6 +14,8 @@ mod contract;
 mod eval;
 mod export;
 mod fit;
+mod peer;
 mod plot;
 mod render;
 mod rtrace;
+mod safety;

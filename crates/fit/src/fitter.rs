@@ -8,7 +8,9 @@ use crate::data::IncidenceData;
 use crate::params::{ParamMap, Target};
 use crate::prepare;
 use crate::problem::Block;
-use crate::report::{FitReport, FitWarning, ParamEstimate, StartRecord, StderrRatio, Termination};
+use crate::report::{
+    FitReport, FitWarning, ParamEstimate, RobustRecord, StartRecord, StderrRatio, Termination,
+};
 use crate::robust;
 use crate::solve::{Solved, Solver, Stage};
 use crate::uncertainty::standard_errors;
@@ -25,8 +27,11 @@ const BRIGHT_SAMPLES: usize = 250;
 /// Samples of the polish of the best start before the fit on every
 /// sample: from its optimum, the full fit converges in three steps.
 const POLISH_SAMPLES: usize = 2000;
-/// Rounds of robust reweighting.
-const IRLS_ROUNDS: usize = 5;
+/// Robust reweighting stops when no parameter moves by more than this
+/// (relative) in a round...
+const IRLS_TOLERANCE: f64 = 1e-6;
+/// ...or after this many rounds, with a warning.
+const IRLS_MAX_ROUNDS: usize = 100;
 
 /// Fits one incidence.
 pub fn fit_incidence(data: &IncidenceData, config: &FitConfig) -> Result<FitReport, FitError> {
@@ -143,13 +148,25 @@ fn fit_many(
     }
 
     // Robust loss by iteratively reweighted least squares.
+    // Each round weighs the samples by the loss at the current residuals
+    // and refits, until the parameters settle: then the weights and the
+    // parameters agree, which is the robust loss's minimum.
+    let mut robust_record = None;
     if config.loss != RobustLoss::None {
         let base = blocks.clone();
-        for _ in 0..IRLS_ROUNDS {
+        let physical = |u: &DVector<f64>| -> Vec<f64> {
+            (0..map.len()).map(|i| map.to_physical(i, u[i]).0).collect()
+        };
+        let mut record = RobustRecord {
+            sigma: f64::NAN,
+            rounds: 0,
+            settled: false,
+        };
+        while record.rounds < IRLS_MAX_ROUNDS {
             let Some(r) = solver.problem(&base).residual_vector(&solved.u) else {
                 break;
             };
-            let all = robust::multipliers(&r, channels, config.loss);
+            let (all, sigma) = robust::multipliers(&r, channels, config.loss);
             let mut rest = all.as_slice();
             for b in blocks.iter_mut() {
                 let (mine, others) = rest.split_at(b.len());
@@ -157,16 +174,26 @@ fn fit_many(
                 b.set_factors(config.residual, floor);
                 rest = others;
             }
-            let previous = solved.u.clone();
-            solved = solver.solve(&blocks, previous.clone(), Stage::FINAL);
+            let before = physical(&solved.u);
+            solved = solver.solve(&blocks, solved.u.clone(), Stage::FINAL);
             evaluations += solved.evaluations;
-            if (&solved.u - &previous).amax() < 1e-8 {
+            record.rounds += 1;
+            record.sigma = sigma;
+            let change = physical(&solved.u)
+                .iter()
+                .zip(&before)
+                .map(|(a, b)| (a - b).abs() / b.abs().max(1e-6))
+                .fold(0.0, f64::max);
+            if change < IRLS_TOLERANCE {
+                record.settled = true;
                 break;
             }
         }
+        robust_record = Some(record);
     }
 
     let report = Reported {
+        robust: robust_record,
         label,
         data,
         n_points,
@@ -180,6 +207,7 @@ fn fit_many(
 
 /// What the report needs besides the solution.
 struct Reported<'a> {
+    robust: Option<RobustRecord>,
     label: &'a str,
     data: &'a [IncidenceData],
     n_points: usize,
@@ -298,6 +326,11 @@ impl Reported<'_> {
         if args[3] < 1e-4 {
             warnings.push(FitWarning::DegenerateLobe);
         }
+        if let Some(r) = &self.robust
+            && !r.settled
+        {
+            warnings.push(FitWarning::RobustNotSettled { rounds: r.rounds });
+        }
         let successful = termination.was_successful();
         let termination = Termination::from_lm(&termination);
         if !successful {
@@ -331,6 +364,7 @@ impl Reported<'_> {
             starts: self.records,
             warnings,
             adequacy: None,
+            robust: self.robust,
         })
     }
 }

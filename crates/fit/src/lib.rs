@@ -76,7 +76,9 @@ pub use recipe::{
     BeamOrigin, ColourConversion, Conversion, DataUnit, PreparedMeasurement, RawScale, Recipe,
     RecipeError, ScaleRule, WeightRule,
 };
-pub use report::{FitReport, FitWarning, ParamEstimate, StartRecord, StderrRatio, Termination};
+pub use report::{
+    FitReport, FitWarning, ParamEstimate, RobustRecord, StartRecord, StderrRatio, Termination,
+};
 pub use result::{FIT_JSON_SCHEMA, FitResult, InputFile, Provenance, ReadFitError, SetWarning};
 pub use set::{FitSetError, FitSetOptions, NoProgress, Progress, fit_set};
 pub use summary::summary;

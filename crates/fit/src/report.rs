@@ -170,6 +170,9 @@ pub struct FitReport {
     /// Whether the model describes the data (made by [`crate::fit_set`]).
     #[serde(default)]
     pub adequacy: Option<crate::diagnose::Adequacy>,
+    /// The robust loss's reweighting, when there was one.
+    #[serde(default)]
+    pub robust: Option<RobustRecord>,
 }
 
 impl FitReport {
@@ -191,6 +194,18 @@ impl std::fmt::Display for Termination {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(self.label())
     }
+}
+
+/// How the robust loss's reweighting went.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct RobustRecord {
+    /// σ of the last round: 1.4826 × the median |residual|, the unit of
+    /// the loss's threshold (Huber's c σ is scipy's `f_scale`).
+    pub sigma: f64,
+    /// Reweighting rounds made.
+    pub rounds: usize,
+    /// The parameters settled (moved by less than 1e-6, relative).
+    pub settled: bool,
 }
 
 /// A parameter whose sandwich standard error exceeds the plain one.
@@ -227,6 +242,11 @@ pub enum FitWarning {
     NotConverged {
         /// Why it stopped.
         termination: Termination,
+    },
+    /// The robust loss's reweighting hit its round limit unsettled.
+    RobustNotSettled {
+        /// Rounds made.
+        rounds: usize,
     },
     /// The data's ρ_dh (or τ_dh) and the model's differ by more than 5%.
     EnergyMismatch {
@@ -276,6 +296,11 @@ impl std::fmt::Display for FitWarning {
             FitWarning::NotConverged { termination } => {
                 write!(f, "optimiser stopped without converging: {termination:?}")
             }
+            FitWarning::RobustNotSettled { rounds } => write!(
+                f,
+                "the robust reweighting did not settle in {rounds} rounds: the parameters are \
+                 not yet the robust loss's minimum"
+            ),
             FitWarning::EnergyMismatch { data, model } => write!(
                 f,
                 "the model does not carry the data's energy: data ρ_dh {data:.4}, model {model:.4} \

@@ -7,10 +7,12 @@ use nalgebra::DVector;
 
 /// The IRLS multiplier (the square root of the weight) of each sample,
 /// from the residuals `r` (`channels` per sample, in sample order): the
-/// sample's largest channel residual decides.
-pub(crate) fn multipliers(r: &DVector<f64>, channels: usize, loss: RobustLoss) -> Vec<f64> {
+/// sample's largest channel residual decides. Also returns σ, the robust
+/// standard deviation the loss's threshold is measured in.
+pub(crate) fn multipliers(r: &DVector<f64>, channels: usize, loss: RobustLoss) -> (Vec<f64>, f64) {
     let sigma = robust_sigma(r);
-    r.as_slice()
+    let multipliers = r
+        .as_slice()
         .chunks(channels)
         .map(|sample| {
             let z = sample.iter().map(|x| x.abs()).fold(0.0, f64::max) / sigma;
@@ -27,7 +29,8 @@ pub(crate) fn multipliers(r: &DVector<f64>, channels: usize, loss: RobustLoss) -
             };
             w.sqrt()
         })
-        .collect()
+        .collect();
+    (multipliers, sigma)
 }
 
 /// 1.4826 × the median absolute residual, a robust standard deviation.

@@ -46,6 +46,7 @@ fn report(kind: MaterialKind, theta_in: f64, args: &[f64]) -> FitReport {
         starts: Vec::new(),
         warnings: Vec::new(),
         adequacy: None,
+        robust: None,
     }
 }
 
