@@ -28,8 +28,14 @@ pub fn format_report(report: &Report, config: &Config) -> String {
     let _ = writeln!(w, "panics        {}", report.panics.len());
     let _ = writeln!(
         w,
-        "hangs         {} (cases over {:.1} s)",
+        "hangs         {} (cases over {:.1} s of CPU time)",
         report.hangs.len(),
+        config.hang_limit.as_secs_f64()
+    );
+    let _ = writeln!(
+        w,
+        "slow wall     {} (over {:.1} s of wall time only: waiting for a busy CPU)",
+        report.slow_under_load.len(),
         config.hang_limit.as_secs_f64()
     );
     let _ = writeln!(w, "anomalies     {}", report.anomalies.len());
@@ -73,6 +79,7 @@ pub fn format_report(report: &Report, config: &Config) -> String {
     for (title, list) in [
         ("panics", &report.panics),
         ("hangs", &report.hangs),
+        ("slow under load", &report.slow_under_load),
         ("anomalies", &report.anomalies),
     ] {
         if list.is_empty() {

@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
 
+use brtf_fuzz::run::thread_cpu_time;
 use brtf_fuzz::{Config, SeedSources, Seeds, Target, format_report, make_case, run, run_case};
 use clap::Parser;
 
@@ -121,8 +122,20 @@ fn main() -> ExitCode {
             eprintln!("brtf-fuzz: error: cannot write {}: {e}", path.display());
             return ExitCode::from(2);
         }
+        let began = std::time::Instant::now();
+        let cpu_before = thread_cpu_time();
         let outcome = run_case(&case);
-        println!("{outcome:?}");
+        let cpu = thread_cpu_time()
+            .zip(cpu_before)
+            .map(|(after, before)| after.saturating_sub(before));
+        println!(
+            "{outcome:?}\n{:.1} ms wall, {} CPU",
+            began.elapsed().as_secs_f64() * 1e3,
+            cpu.map_or_else(
+                || "unknown".into(),
+                |c| format!("{:.1} ms", c.as_secs_f64() * 1e3)
+            )
+        );
         return ExitCode::SUCCESS;
     }
     let seeds_count = seeds.all.len();

@@ -184,8 +184,11 @@ pub struct Report {
     pub per_mutation: HashMap<Kind, u64>,
     /// Cases that panicked.
     pub panics: Vec<Finding>,
-    /// Cases that ran longer than the hang limit.
+    /// Cases whose CPU time passed the hang limit.
     pub hangs: Vec<Finding>,
+    /// Cases whose wall time passed the hang limit while their CPU time
+    /// stayed below it (the machine was busy with other work).
+    pub slow_under_load: Vec<Finding>,
     /// Cases with a wrong result that is not a crash.
     pub anomalies: Vec<Finding>,
     /// The slowest case: (time, case number, origin, target).
@@ -313,10 +316,14 @@ pub fn run(seeds: &Seeds, config: &Config) -> Report {
                             .store(start.elapsed().as_nanos() as u64, Ordering::Relaxed);
                         slot.case_plus_one.store(index + 1, Ordering::Release);
                         let began = Instant::now();
+                        let cpu_before = thread_cpu_time();
                         let outcome = run_case(&case);
                         let elapsed = began.elapsed();
+                        let cpu = thread_cpu_time()
+                            .zip(cpu_before)
+                            .map(|(after, before)| after.saturating_sub(before));
                         slot.case_plus_one.store(0, Ordering::Release);
-                        record(&mut local, &case, outcome, elapsed, config);
+                        record(&mut local, &case, outcome, (elapsed, cpu), config);
                         if config.progress && (index + 1) % (config.cases / 20).max(1) == 0 {
                             eprintln!(
                                 "brtf-fuzz: {} / {} cases, {:.0} s",
@@ -336,7 +343,12 @@ pub fn run(seeds: &Seeds, config: &Config) -> Report {
         done.store(true, Ordering::Release);
     });
     let mut report = report.into_inner().unwrap();
-    for list in [&mut report.panics, &mut report.hangs, &mut report.anomalies] {
+    for list in [
+        &mut report.panics,
+        &mut report.hangs,
+        &mut report.slow_under_load,
+        &mut report.anomalies,
+    ] {
         list.sort_by_key(|f| f.case);
     }
     report.elapsed = start.elapsed();
@@ -387,7 +399,7 @@ fn record(
     report: &mut Report,
     case: &Case,
     outcome: Result<Outcome, String>,
-    elapsed: Duration,
+    (elapsed, cpu): (Duration, Option<Duration>),
     config: &Config,
 ) {
     report.cases += 1;
@@ -419,18 +431,37 @@ fn record(
                 samples.push(message);
             }
         }
-        Ok(Outcome::Anomaly(message)) => {
+        Ok(Outcome::Anomaly { class, detail }) => {
             stats.rejected += 1;
-            report.anomalies.push(finding("anomaly", message));
+            report
+                .anomalies
+                .push(finding("anomaly", format!("{class}\n{detail}")));
         }
         Err(panic) => report.panics.push(finding("panic", panic)),
     }
+    // A hang is judged on the case's own CPU time: on a 2-core machine
+    // shared with compilers, wall time alone would blame the parser for
+    // waiting its turn. Wall-time overruns are counted apart.
     if elapsed > config.hang_limit {
-        report.hangs.push(finding(
-            "hang",
-            format!("ran {:.2} s", elapsed.as_secs_f64()),
-        ));
+        let cpu_text =
+            cpu.map_or_else(|| "unknown".into(), |c| format!("{:.2} s", c.as_secs_f64()));
+        let detail = format!("ran {:.2} s (CPU time {cpu_text})", elapsed.as_secs_f64());
+        if cpu.is_none_or(|c| c > config.hang_limit) {
+            let message = format!("CPU time over the limit\n{detail}");
+            report.hangs.push(finding("hang", message));
+        } else {
+            let message = format!("wall time over the limit, CPU time under it\n{detail}");
+            report.slow_under_load.push(finding("slow", message));
+        }
     }
+}
+
+/// CPU time this thread has used so far (`/proc/thread-self/schedstat`,
+/// nanoseconds on the CPU), or `None` where that file does not exist.
+pub fn thread_cpu_time() -> Option<Duration> {
+    let text = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    let ns: u64 = text.split_ascii_whitespace().next()?.parse().ok()?;
+    Some(Duration::from_nanos(ns))
 }
 
 fn merge(into: &mut Report, from: Report) {
@@ -448,6 +479,7 @@ fn merge(into: &mut Report, from: Report) {
     }
     into.panics.extend(from.panics);
     into.hangs.extend(from.hangs);
+    into.slow_under_load.extend(from.slow_under_load);
     into.anomalies.extend(from.anomalies);
     if let Some(s) = from.slowest
         && into.slowest.as_ref().is_none_or(|i| s.0 > i.0)
@@ -468,6 +500,9 @@ fn merge(into: &mut Report, from: Report) {
 /// each kind, so a systematic bug does not fill the disk.
 fn save(config: &Config, kind: &str, case: &Case) -> Option<PathBuf> {
     const MAX_SAVED_PER_KIND: usize = 50;
+    if kind == "slow" {
+        return None; // not a bug; big inputs, many of them
+    }
     let dir = config.findings_dir.as_ref()?;
     std::fs::create_dir_all(dir).ok()?;
     let prefix = format!("{kind}-");

@@ -29,8 +29,13 @@ pub enum Outcome {
     Accepted,
     /// The input was refused with this error message.
     Rejected(String),
-    /// Something is wrong without a crash; the text says what.
-    Anomaly(String),
+    /// Something is wrong without a crash.
+    Anomaly {
+        /// The kind of problem, for grouping (`written .mpc does not read back`).
+        class: &'static str,
+        /// The details.
+        detail: String,
+    },
 }
 
 /// Runs `bytes`, named `name`, through `target`.
@@ -55,45 +60,45 @@ fn gonio(bytes: &[u8], name: &str, format: Option<SourceFormat>) -> Outcome {
             let message = e.to_string();
             let lines = line_count(bytes, true);
             return match e.line() {
-                Some(line) if line == 0 || line > lines => Outcome::Anomaly(format!(
-                    "error on line {line} of a {lines}-line file: {message}"
-                )),
+                Some(line) if line == 0 || line > lines => anomaly(
+                    "error line outside the file",
+                    format!("error on line {line} of a {lines}-line file: {message}"),
+                ),
                 _ => located(message, name),
             };
         }
     };
     let _ = measurement.summary();
-    if let Some(problem) = round_trip(&measurement, name) {
-        return Outcome::Anomaly(problem);
+    if let Some((class, detail)) = round_trip(&measurement, name) {
+        return anomaly(class, detail);
     }
     Outcome::Accepted
 }
 
-/// Writes `m` in both formats and reads it back; `Some(problem)` if that fails.
-fn round_trip(m: &Measurement, name: &str) -> Option<String> {
+/// Writes `m` in both formats and reads it back; `Some((class, detail))`
+/// if that fails.
+fn round_trip(m: &Measurement, name: &str) -> Option<(&'static str, String)> {
     let mountain = brtf_gonio::to_mountain_string(m);
     match brtf_gonio::read_bytes_as(mountain.as_bytes(), name, SourceFormat::Mountain) {
         Ok(again) if again.len() == m.len() => {}
         Ok(again) => {
-            return Some(format!(
-                "written as Mountain, {} rows read back as {}",
-                m.len(),
-                again.len()
+            return Some((
+                "written Mountain file reads back other rows",
+                format!("{} rows read back as {}", m.len(), again.len()),
             ));
         }
-        Err(e) => return Some(format!("written as Mountain, does not read back: {e}")),
+        Err(e) => return Some(("written Mountain file does not read back", e.to_string())),
     }
     if let Ok(mpc) = brtf_gonio::to_mpc_string(m) {
         match brtf_gonio::read_bytes_as(mpc.as_bytes(), name, SourceFormat::Mpc) {
             Ok(again) if again.len() == m.len() => {}
             Ok(again) => {
-                return Some(format!(
-                    "written as .mpc, {} rows read back as {}",
-                    m.len(),
-                    again.len()
+                return Some((
+                    "written .mpc file reads back other rows",
+                    format!("{} rows read back as {}", m.len(), again.len()),
                 ));
             }
-            Err(e) => return Some(format!("written as .mpc, does not read back: {e}")),
+            Err(e) => return Some(("written .mpc file does not read back", e.to_string())),
         }
     }
     None
@@ -111,11 +116,14 @@ fn rad(bytes: &[u8], name: &str) -> Outcome {
         if let Ok(material) = brtf_radiance::material_from_primitive(p, name)
             && let Some(problem) = eval_problem(&material)
         {
-            return Outcome::Anomaly(format!("`{}` ({}): {problem}", p.name, p.kind));
+            return anomaly(
+                "valid material evaluates to a non-finite BSDF",
+                format!("`{}` ({}): {problem}", p.name, p.kind),
+            );
         }
         let printed = brtf_radiance::format_primitive(p);
         if let Err(e) = brtf_radiance::parse_primitives(&printed, name) {
-            return Outcome::Anomaly(format!("a printed primitive does not parse again: {e}"));
+            return anomaly("printed primitive does not parse again", e.to_string());
         }
     }
     match brtf_radiance::select_material(&primitives, None, name) {
@@ -127,10 +135,10 @@ fn rad(bytes: &[u8], name: &str) -> Outcome {
 fn rad_error(e: &brtf_radiance::RadError, bytes: &[u8], name: &str) -> Outcome {
     let lines = line_count(bytes, false);
     if e.line == 0 || e.line > lines {
-        return Outcome::Anomaly(format!(
-            "error on line {} of a {lines}-line file: {e}",
-            e.line
-        ));
+        return anomaly(
+            "error line outside the file",
+            format!("error on line {} of a {lines}-line file: {e}", e.line),
+        );
     }
     located(e.to_string(), name)
 }
@@ -151,7 +159,10 @@ fn fit_json(bytes: &[u8], name: &str) -> Outcome {
         if let Some(material) = result.material_at(theta, None)
             && let Some(problem) = eval_problem(&material)
         {
-            return Outcome::Anomaly(format!("material at theta_in = {theta}: {problem}"));
+            return anomaly(
+                "valid material evaluates to a non-finite BSDF",
+                format!("material at theta_in = {theta}: {problem}"),
+            );
         }
     }
     match brtf_radiance::export::exports(&result, &brtf_radiance::export::ExportOptions::default())
@@ -188,8 +199,15 @@ fn located(message: String, name: &str) -> Outcome {
     if message.starts_with(&prefix) {
         Outcome::Rejected(message)
     } else {
-        Outcome::Anomaly(format!("error does not start with `{prefix}`: {message}"))
+        anomaly(
+            "error does not start with the file name",
+            format!("expected `{prefix}`: {message}"),
+        )
     }
+}
+
+fn anomaly(class: &'static str, detail: String) -> Outcome {
+    Outcome::Anomaly { class, detail }
 }
 
 /// Lines in `bytes`, counting `\n` (and, when `lone_cr`, `\r` not followed
