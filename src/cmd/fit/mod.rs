@@ -29,16 +29,16 @@ impl Progress for Bar {
 }
 
 pub fn run(args: FitArgs) -> Result<()> {
-    let name = match &args.name {
+    let mut options = args.options(String::new())?;
+    options.validate()?;
+    options.name = match &args.name {
         Some(name) => name.clone(),
         None => default_name(&args.files)?,
     };
     let out = args
         .out
         .clone()
-        .unwrap_or_else(|| Path::new("fits").join(&name));
-    let options = args.options(name)?;
-    options.validate()?;
+        .unwrap_or_else(|| Path::new("fits").join(&options.name));
     let update = FolderUpdate::fresh(&out)?;
     brtf_io::check_replaceable(update.target(), &args.files, args.force)?;
     let bar = Bar(ProgressBar::new(0).with_style(
