@@ -80,47 +80,6 @@ pub struct SynthArgs {
 /// The header line that marks brtf synth's own files (which it may replace).
 const SYNTH_MARKER: &str = "synth (synthetic data, not a measurement)";
 
-/// The most samples one synthetic file may hold (the steps decide it).
-const MAX_SAMPLES: f64 = 2e6;
-
-/// Range checks of the instrument and layout options, before any work.
-fn check_numbers(args: &SynthArgs) -> Result<()> {
-    use brtf_model::OptionError as E;
-    let angle = |o, v: f64, top: f64| E::check(o, v, (0.0..top).contains(&v), "0 ≤ angle < 90");
-    E::check("--phi-in", args.phi_in, args.phi_in.is_finite(), "finite")?;
-    let ok = args.noise >= 0.0 && args.noise < 1.0;
-    E::check("--noise", args.noise, ok, "0 ≤ relative noise < 1")?;
-    let ok = args.noise_floor >= 0.0 && args.noise_floor.is_finite();
-    E::check("--noise-floor", args.noise_floor, ok, "≥ 0")?;
-    angle("--source-aperture", args.source_aperture, 90.0)?;
-    angle("--detector-aperture", args.detector_aperture, 90.0)?;
-    angle("--blind-spot", args.blind_spot, 90.0)?;
-    for (option, step) in [
-        ("--coarse-step", args.coarse_step),
-        ("--fine-step", args.fine_step),
-    ] {
-        E::check(
-            option,
-            step,
-            step > 0.0 && step <= 30.0,
-            "0 < step ≤ 30 degrees",
-        )?;
-    }
-    // Samples ≈ hemisphere / coarse cell + (20° patch) / fine cell, both sides.
-    let (c, f) = (args.coarse_step.to_radians(), args.fine_step.to_radians());
-    let samples = 2.0 * (std::f64::consts::TAU / (c * c) + 0.383 / (f * f));
-    let ok = samples <= MAX_SAMPLES;
-    let allowed =
-        "steps giving at most 2,000,000 samples per file (about 0.1° coarse, 0.025° fine)";
-    E::check(
-        "--coarse-step/--fine-step",
-        args.coarse_step.min(args.fine_step),
-        ok,
-        allowed,
-    )?;
-    Ok(())
-}
-
 /// The model options of `--material` (same spellings as `brtf eval`).
 #[derive(Args, Debug)]
 pub struct SynthModelArgs {
@@ -187,7 +146,24 @@ pub fn run(args: SynthArgs) -> Result<()> {
     if matches!(args.format, FormatArg::Mpc) && channels == Channels::Xyz {
         bail!("the .mpc format holds one value per row; use --format mountain for --channels 3");
     }
-    check_numbers(&args)?;
+    brtf_model::OptionError::check("--phi-in", args.phi_in, args.phi_in.is_finite(), "finite")?;
+    let instrument = Instrument {
+        source_aperture_deg: args.source_aperture,
+        detector_aperture_deg: args.detector_aperture,
+        noise_relative: args.noise,
+        noise_floor: args.noise_floor,
+        blind_spot_deg: args.blind_spot,
+        holder_gap: !args.no_holder_gap,
+        back_rows: !args.no_back_rows,
+        aperture_rays: 3,
+    };
+    let layout = Layout {
+        coarse_step_deg: args.coarse_step,
+        fine_step_deg: args.fine_step,
+        max_theta_deg: 88.0,
+    };
+    instrument.validate()?;
+    layout.validate()?;
     let prefix = args.prefix.clone().unwrap_or_else(|| {
         args.out
             .file_name()
@@ -218,21 +194,8 @@ pub fn run(args: SynthArgs) -> Result<()> {
         let spec = SynthSpec {
             truth,
             incidence: Incidence::new(theta, args.phi_in),
-            instrument: Instrument {
-                source_aperture_deg: args.source_aperture,
-                detector_aperture_deg: args.detector_aperture,
-                noise_relative: args.noise,
-                noise_floor: args.noise_floor,
-                blind_spot_deg: args.blind_spot,
-                holder_gap: !args.no_holder_gap,
-                back_rows: !args.no_back_rows,
-                aperture_rays: 3,
-            },
-            layout: Layout {
-                coarse_step_deg: args.coarse_step,
-                fine_step_deg: args.fine_step,
-                max_theta_deg: 88.0,
-            },
+            instrument: instrument.clone(),
+            layout: layout.clone(),
             channels,
             seed: args.seed.wrapping_add(index as u64),
             sample_name: prefix.clone(),

@@ -49,6 +49,7 @@ pub mod select;
 pub mod solid_angle;
 pub mod summary;
 pub mod synth;
+mod synth_limits;
 pub mod write;
 
 pub use convert::{Converted, GRAZING_COS_LIMIT};
@@ -66,4 +67,5 @@ pub use read::{
 pub use select::{DEFAULT_THETA_CAP_DEG, Gate, GateContext, Selection};
 pub use solid_angle::{SolidAngleSource, SolidAngles, compute_solid_angles, solid_angles};
 pub use summary::{HemisphereSummary, Peak, Summary};
+pub use synth_limits::MAX_SYNTH_SAMPLES;
 pub use write::{to_mountain_string, to_mpc_string, write_mountain, write_mpc, write_path};
