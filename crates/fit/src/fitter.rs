@@ -27,6 +27,8 @@ const BRIGHT_SAMPLES: usize = 250;
 /// Samples of the polish of the best start before the fit on every
 /// sample: from its optimum, the full fit converges in three steps.
 const POLISH_SAMPLES: usize = 2000;
+/// Multi-start ends polished and compared on every sample.
+const CANDIDATES: usize = 3;
 /// Robust reweighting stops when no parameter moves by more than this
 /// (relative) in a round...
 const IRLS_TOLERANCE: f64 = 1e-6;
@@ -101,9 +103,11 @@ fn fit_many(
     };
     let mut evaluations = 0;
 
-    // Multi-start on a subsample, then the full fit from the best start.
+    // Multi-start on a subsample; the best few ends (always with the
+    // data-driven start's) polished and judged on every sample; the full
+    // fit from the best of them. LM only lowers the cost from its start,
+    // so the result is never worse than any candidate.
     let mut records = Vec::new();
-    let mut best: Option<(DVector<f64>, f64)> = None;
     let thin = |target: usize| -> Vec<Block> {
         blocks
             .iter()
@@ -111,33 +115,56 @@ fn fit_many(
             .map(|(b, &t)| prepare::subsample(b, share(target), t))
             .collect()
     };
+    let mut ends: Vec<DVector<f64>> = vec![starts[0].1.clone()];
     if starts.len() > 1 {
         let sub = thin(START_SAMPLES);
-        // The starts are independent: run them in parallel, then pick the
-        // lowest cost (the first on ties), so the choice is deterministic.
-        let ends: Vec<Solved> = starts
+        // The starts are independent: run them in parallel; the order of
+        // the candidates (lowest cost first, the first on ties) keeps the
+        // choice deterministic.
+        let solved: Vec<Solved> = starts
             .par_iter()
             .map(|(_, u0)| solver.solve(&sub, u0.clone(), Stage::START))
             .collect();
-        for ((rough, _), end) in starts.iter().zip(ends) {
+        for ((rough, _), end) in starts.iter().zip(&solved) {
             evaluations += end.evaluations;
             records.push(StartRecord {
                 rough: *rough,
-                cost: end.cost,
+                subsample_cost: end.cost,
+                full_cost: None,
             });
-            if best.as_ref().is_none_or(|(_, c)| end.cost < *c) {
-                best = Some((end.u, end.cost));
-            }
         }
-    }
-    let mut u_start = best.map_or_else(|| starts[0].1.clone(), |(u, _)| u);
-    if polish {
-        let polished = solver.solve(&thin(POLISH_SAMPLES), u_start.clone(), Stage::START);
-        evaluations += polished.evaluations;
-        if polished.cost.is_finite() {
-            u_start = polished.u;
+        let mut order: Vec<usize> = (0..solved.len()).collect();
+        order.sort_by(|&a, &b| solved[a].cost.total_cmp(&solved[b].cost));
+        order.truncate(CANDIDATES);
+        // The data-driven start (the first) is always a candidate.
+        if !order.contains(&0) {
+            order.push(0);
         }
+        ends = order.iter().map(|&i| solved[i].u.clone()).collect();
+        let full_costs = candidates_full_costs(
+            &solver,
+            &blocks,
+            &mut ends,
+            polish.then(|| thin(POLISH_SAMPLES)),
+            &mut evaluations,
+        );
+        for (&i, cost) in order.iter().zip(&full_costs) {
+            records[i].full_cost = Some(*cost);
+        }
+        let best = (0..ends.len())
+            .min_by(|&a, &b| full_costs[a].total_cmp(&full_costs[b]))
+            .expect("at least one candidate");
+        ends.swap(0, best);
+    } else if polish {
+        candidates_full_costs(
+            &solver,
+            &blocks,
+            &mut ends,
+            Some(thin(POLISH_SAMPLES)),
+            &mut evaluations,
+        );
     }
+    let u_start = ends.swap_remove(0);
     let mut solved = solver.solve(&blocks, u_start, Stage::FINAL);
     evaluations += solved.evaluations;
     if !solved.cost.is_finite() {
@@ -203,6 +230,40 @@ fn fit_many(
         started,
     };
     report.build(&solver, &blocks, solved)
+}
+
+/// Polishes each candidate on `polish` (when given; a candidate whose
+/// polish fails keeps its point) and returns each one's cost on every
+/// sample.
+fn candidates_full_costs(
+    solver: &Solver<'_>,
+    blocks: &[Block<'_>],
+    candidates: &mut [DVector<f64>],
+    polish: Option<Vec<Block<'_>>>,
+    evaluations: &mut usize,
+) -> Vec<f64> {
+    if let Some(sub) = &polish {
+        let polished: Vec<Solved> = candidates
+            .par_iter()
+            .map(|u| solver.solve(sub, u.clone(), Stage::START))
+            .collect();
+        for (u, p) in candidates.iter_mut().zip(polished) {
+            *evaluations += p.evaluations;
+            if p.cost.is_finite() {
+                *u = p.u;
+            }
+        }
+    }
+    let problem = solver.problem(blocks);
+    candidates
+        .iter()
+        .map(|u| {
+            *evaluations += 1;
+            problem
+                .residual_vector(u)
+                .map_or(f64::INFINITY, |r| 0.5 * r.norm_squared())
+        })
+        .collect()
 }
 
 /// What the report needs besides the solution.

@@ -126,8 +126,12 @@ impl ParamEstimate {
 pub struct StartRecord {
     /// Starting roughness (u, v).
     pub rough: [f64; 2],
-    /// Cost reached on the subsample.
-    pub cost: f64,
+    /// Cost reached on the multi-start's subsample (about 500 samples, so
+    /// not comparable with the fit's `cost`).
+    pub subsample_cost: f64,
+    /// For the few best starts: the cost on every sample after the
+    /// polish, comparable with the fit's `cost`, which is never above it.
+    pub full_cost: Option<f64>,
 }
 
 /// The result of fitting one incidence (or all at once).
