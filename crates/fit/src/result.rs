@@ -115,20 +115,28 @@ pub struct FitResult {
 #[non_exhaustive]
 pub enum ReadFitError {
     /// The file could not be read.
-    #[error("cannot read {}: {source}", path.display())]
+    #[error("cannot read {}: {error}", path.display())]
     Io {
         /// The file.
         path: PathBuf,
-        /// The OS error.
-        source: std::io::Error,
+        /// The OS error (not a `source`: the message already shows it).
+        error: std::io::Error,
     },
     /// The file is not JSON, or not a brtf fit of this schema.
-    #[error("{}:{}: not a brtf fit result: {source}", path.display(), source.line())]
+    #[error("{}:{}: not a brtf fit result: {error}", path.display(), error.line())]
     Parse {
         /// The file.
         path: PathBuf,
         /// What serde found.
-        source: serde_json::Error,
+        error: serde_json::Error,
+    },
+    /// The file parses but holds what no fit makes (e.g. a broken table).
+    #[error("{}: not a valid brtf fit result: {why}", path.display())]
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        why: String,
     },
     /// The schema version is not the one this brtf reads.
     #[error(
@@ -153,18 +161,18 @@ impl FitResult {
         } else {
             path.to_path_buf()
         };
-        let text = std::fs::read_to_string(&path).map_err(|source| ReadFitError::Io {
+        let text = std::fs::read_to_string(&path).map_err(|error| ReadFitError::Io {
             path: path.clone(),
-            source,
+            error,
         })?;
         Self::from_json(&text, &path)
     }
 
     /// Parses the text of a `fit.json` read from `path` (for messages).
     pub fn from_json(text: &str, path: &Path) -> Result<FitResult, ReadFitError> {
-        let parse = |source| ReadFitError::Parse {
+        let parse = |error| ReadFitError::Parse {
             path: path.to_path_buf(),
-            source,
+            error,
         };
         let value: serde_json::Value = serde_json::from_str(text).map_err(parse)?;
         // Version 1 had no `schema` field.
@@ -179,7 +187,38 @@ impl FitResult {
             });
         }
         // From the text again, so that errors name their line.
-        serde_json::from_str(text).map_err(parse)
+        let result: FitResult = serde_json::from_str(text).map_err(parse)?;
+        result.validate().map_err(|why| ReadFitError::Invalid {
+            path: path.to_path_buf(),
+            why,
+        })?;
+        Ok(result)
+    }
+
+    /// Checks what readers rely on beyond the types: the table, and each
+    /// report's arguments.
+    fn validate(&self) -> Result<(), String> {
+        if let Some(table) = &self.table {
+            table.validate().map_err(|e| e.to_string())?;
+            if table.kind != self.config.kind {
+                return Err(format!(
+                    "the table is of {}, the fit of {}",
+                    table.kind, self.config.kind
+                ));
+            }
+        }
+        let n = self.config.kind.param_names().len();
+        for r in self.incidences.iter().chain(&self.global) {
+            if r.material_args.len() != n || !r.material_args.iter().all(|a| a.is_finite()) {
+                return Err(format!(
+                    "{}: {} material arguments, a {} has {n} finite ones",
+                    r.source,
+                    r.material_args.len(),
+                    self.config.kind
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// Writes `DIR/fit.json` and `DIR/params.csv`, each atomically.

@@ -31,6 +31,9 @@ pub enum TableError {
     /// The interpolated parameters are not a valid material.
     #[error("interpolated parameters are not a valid material: {0}")]
     Material(#[from] ModelError),
+    /// A stored table is not one brtf could have made.
+    #[error("invalid θ_in table: {0}")]
+    Invalid(String),
 }
 
 /// Material parameters tabulated over θ_in.
@@ -92,6 +95,41 @@ impl ParamTable {
             self.theta_in[0],
             *self.theta_in.last().expect("two rows or more"),
         )
+    }
+
+    /// Checks what interpolation relies on, for a table read from a file:
+    /// two rows or more, finite θ_in strictly ascending, one row of the
+    /// type's arguments per θ_in, each a valid material.
+    pub fn validate(&self) -> Result<(), TableError> {
+        let invalid = |why: String| Err(TableError::Invalid(why));
+        if self.theta_in.len() < 2 {
+            return Err(TableError::NeedTwoIncidences(self.theta_in.len()));
+        }
+        if self.args.len() != self.theta_in.len() {
+            return invalid(format!(
+                "{} rows of arguments for {} θ_in values",
+                self.args.len(),
+                self.theta_in.len()
+            ));
+        }
+        if !self.theta_in.iter().all(|t| t.is_finite()) {
+            return invalid("a θ_in is not a finite number".into());
+        }
+        if let Some(w) = self.theta_in.windows(2).find(|w| w[1] <= w[0]) {
+            return invalid(format!("θ_in is not ascending at {}° → {}°", w[0], w[1]));
+        }
+        let n = self.kind.param_names().len();
+        for (row, t) in self.args.iter().zip(&self.theta_in) {
+            if row.len() != n {
+                return invalid(format!(
+                    "the row at {t}° has {} arguments, a {} has {n}",
+                    row.len(),
+                    self.kind
+                ));
+            }
+            Material::new(self.kind, row, Some(DVec3::from_array(self.orientation)))?;
+        }
+        Ok(())
     }
 
     /// Interpolated real arguments at `theta_in` (clamped to the range).

@@ -57,9 +57,6 @@ fn measurement_and_rad_parsers_survive_20000_mutated_inputs() {
 }
 
 #[test]
-#[ignore = "brtf-fit's ParamTable panics on tables fit.json can hold (ragged rows, \
-            unsorted θ_in, fewer than two rows): see docs/reliability.md; \
-            remove this line once FitResult::from_json validates the table"]
 fn fit_json_reader_survives_20000_mutated_inputs() {
     let config = config(&[Target::FitJson]);
     let report = run(&seeds(), &config);
