@@ -615,7 +615,8 @@ fn rad_files_with_impossible_or_misparsed_materials_are_refused_or_read_right() 
             .stderr(Stdio::piped())
             .spawn()
             .unwrap();
-        child.stdin.take().unwrap().write_all(b"10,180\n").unwrap();
+        // brtf refuses a bad file before it reads stdin, and may be gone.
+        let _ = child.stdin.take().unwrap().write_all(b"10,180\n");
         child.wait_with_output().unwrap()
     };
     for (body, expected) in [
