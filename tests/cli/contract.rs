@@ -347,3 +347,50 @@ fn xyz_data_are_fitted_and_exported_in_radiance_rgb() {
         assert!((got / want - 1.0).abs() < 0.01, "colour {reals:?}");
     }
 }
+
+/// A free-scale plastic's `spec` is a fraction of the unknown scale, and
+/// its export says so instead of judging it as Radiance's specularity;
+/// `--mask-holder` drops the pgII holder's shadow and the report says how
+/// many points it masked.
+#[test]
+fn free_scale_plastic_export_and_the_holder_mask() {
+    let dir = temp_dir();
+    let out = dir.path().join("layer");
+    let scan = s(&real_scan("layer_020_030.txt")).to_string();
+    let result = fit_into(
+        &out,
+        std::slice::from_ref(&scan),
+        &[
+            "--model",
+            "plastic",
+            "--gray",
+            "--mask-holder",
+            "--no-adequacy",
+        ],
+    );
+    let masked = result.incidences[0]
+        .gates
+        .iter()
+        .find(|g| matches!(g.gate, Gate::AzimuthBand { .. }))
+        .expect("the holder band gate");
+    assert!(masked.removed > 1000, "{masked:?}");
+    let report = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(report.contains(&format!(
+        "holder band φ_out 270±15° at θ_out &gt;= 70° (−{})",
+        masked.removed
+    )));
+    let rad = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.extension().is_some_and(|e| e == "rad") && !s(p).ends_with("-preview.rad"))
+        .unwrap();
+    let text = std::fs::read_to_string(&rad).unwrap();
+    assert!(
+        text.contains("spec is a fraction of that unknown scale"),
+        "{text}"
+    );
+    assert!(
+        !text.contains("specularity fractions greater than 0.1"),
+        "{text}"
+    );
+}

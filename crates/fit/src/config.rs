@@ -17,6 +17,58 @@ pub enum RobustLoss {
     Cauchy(f64),
 }
 
+impl std::str::FromStr for RobustLoss {
+    type Err = String;
+
+    /// `none`, `huber[:C]` or `cauchy[:C]` (C in robust standard
+    /// deviations; 1.345 and 2.385 by default, 95 % efficient).
+    fn from_str(s: &str) -> Result<RobustLoss, String> {
+        let (name, c) = match s.split_once(':') {
+            Some((n, c)) => match c.parse::<f64>() {
+                Ok(c) if c.is_finite() && c > 0.0 => (n, Some(c)),
+                _ => return Err(format!("bad loss scale `{c}`: need a number above 0")),
+            },
+            None => (s, None),
+        };
+        match name {
+            "none" if c.is_none() => Ok(RobustLoss::None),
+            "huber" => Ok(RobustLoss::Huber(c.unwrap_or(1.345))),
+            "cauchy" => Ok(RobustLoss::Cauchy(c.unwrap_or(2.385))),
+            _ => Err(format!(
+                "expected none, huber[:C] or cauchy[:C], found `{s}`"
+            )),
+        }
+    }
+}
+
+/// A known directional-hemispherical reflectance of the sample,
+/// `VALUE@THETA` (e.g. `0.85@30`), that makes a raw-signal fit absolute.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct KnownReflectance {
+    /// ρ_dh, in (0, 1].
+    pub rho: f64,
+    /// Its incidence, degrees in [0, 90).
+    pub theta_in: f64,
+}
+
+impl std::str::FromStr for KnownReflectance {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<KnownReflectance, String> {
+        let (value, theta) = s
+            .split_once('@')
+            .ok_or("expected VALUE@THETA, e.g. 0.85@30")?;
+        let rho: f64 = value
+            .parse()
+            .map_err(|_| format!("bad reflectance `{value}`"))?;
+        let theta_in: f64 = theta.parse().map_err(|_| format!("bad angle `{theta}`"))?;
+        if !(rho > 0.0 && rho <= 1.0 && (0.0..90.0).contains(&theta_in)) {
+            return Err("need 0 < VALUE ≤ 1 and 0 ≤ THETA < 90".into());
+        }
+        Ok(KnownReflectance { rho, theta_in })
+    }
+}
+
 /// Everything that decides a fit.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FitConfig {

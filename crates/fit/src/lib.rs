@@ -64,7 +64,7 @@ pub(crate) mod serde_kind {
 }
 
 pub use brtf_gonio::Gate;
-pub use config::{FitConfig, FitError, RobustLoss};
+pub use config::{FitConfig, FitError, KnownReflectance, RobustLoss};
 pub use data::{FitSample, GateCount, IncidenceData, Weighting};
 pub use diagnose::{
     Adequacy, ENERGY_TOLERANCE, PEAK_TOLERANCE_DEG, RESIDUAL_KIND_TOLERANCE, ResidualCheck,

@@ -64,7 +64,7 @@ pub use read::{
     detect_format, incidence_from_file_name, read_bytes, read_bytes_as, read_path, read_path_as,
     read_str,
 };
-pub use select::{DEFAULT_THETA_CAP_DEG, Gate, GateContext, Selection};
+pub use select::{DEFAULT_THETA_CAP_DEG, Gate, GateContext, PGII_HOLDER_BAND, Selection};
 pub use solid_angle::{SolidAngleSource, SolidAngles, compute_solid_angles, solid_angles};
 pub use summary::{HemisphereSummary, Peak, Summary};
 pub use synth_limits::MAX_SYNTH_SAMPLES;

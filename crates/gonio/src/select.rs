@@ -47,7 +47,27 @@ pub enum Gate {
         /// The smallest value kept, in the data's unit.
         min: f64,
     },
+    /// Drops a band of azimuths at grazing angles, where a sample holder
+    /// shadows the detector: |φ_out − `center_deg`| ≤ `half_width_deg` and
+    /// θ_out (from the nearer normal) ≥ `min_theta_deg`.
+    AzimuthBand {
+        /// Centre azimuth, degrees.
+        center_deg: f64,
+        /// Half-width in azimuth, degrees.
+        half_width_deg: f64,
+        /// Smallest θ_out dropped, degrees.
+        min_theta_deg: f64,
+    },
 }
+
+/// The pgII holder's shadow (`brtf fit --mask-holder`): φ_out 270 ± 15°
+/// at θ_out ≥ 70°, where the real pgII scans read 2-2.5× below the
+/// opposite azimuth.
+pub const PGII_HOLDER_BAND: Gate = Gate::AzimuthBand {
+    center_deg: 270.0,
+    half_width_deg: 15.0,
+    min_theta_deg: 70.0,
+};
 
 /// What a gate needs to know about the measurement it filters.
 #[derive(Clone, Copy, Debug)]
@@ -91,6 +111,24 @@ impl Gate {
             Gate::MinValue { min } => {
                 OptionError::check("--min-value", min, min.is_finite(), "a finite number")
             }
+            Gate::AzimuthBand {
+                center_deg,
+                half_width_deg,
+                min_theta_deg,
+            } => OptionError::check(
+                "--mask-band",
+                half_width_deg,
+                center_deg.is_finite() && half_width_deg > 0.0 && half_width_deg <= 180.0,
+                "a finite centre and 0 < half-width ≤ 180 degrees",
+            )
+            .and_then(|()| {
+                OptionError::check(
+                    "--mask-band",
+                    min_theta_deg,
+                    (0.0..=90.0).contains(&min_theta_deg),
+                    "0 ≤ θ ≤ 90 degrees",
+                )
+            }),
         }
     }
 
@@ -105,6 +143,16 @@ impl Gate {
                 sample.direction().dot(context.light) < half_angle_deg.to_radians().cos()
             }
             Gate::MinValue { min } => values.iter().all(|&v| v.is_finite() && v >= min),
+            Gate::AzimuthBand {
+                center_deg,
+                half_width_deg,
+                min_theta_deg,
+            } => {
+                let dphi = (sample.phi_deg - center_deg).rem_euclid(360.0);
+                let dphi = dphi.min(360.0 - dphi);
+                let theta = sample.theta_deg.min(180.0 - sample.theta_deg);
+                !(dphi <= half_width_deg && theta >= min_theta_deg)
+            }
         }
     }
 
@@ -121,6 +169,7 @@ impl Gate {
             Gate::ThetaCap { max_deg } => format!("θ_out > {max_deg}°"),
             Gate::BeamMask { half_angle_deg } => format!("{half_angle_deg}° beam mask"),
             Gate::MinValue { min } => format!("value < {min}"),
+            Gate::AzimuthBand { .. } => "holder band".into(),
         }
     }
 }
@@ -138,6 +187,14 @@ impl std::fmt::Display for Gate {
             Gate::ThetaCap { max_deg } => write!(f, "theta_out <= {max_deg}°"),
             Gate::BeamMask { half_angle_deg } => write!(f, "{half_angle_deg}° beam mask"),
             Gate::MinValue { min } => write!(f, "value >= {min}"),
+            Gate::AzimuthBand {
+                center_deg,
+                half_width_deg,
+                min_theta_deg,
+            } => write!(
+                f,
+                "holder band φ_out {center_deg}±{half_width_deg}° at θ_out >= {min_theta_deg}°"
+            ),
         }
     }
 }

@@ -182,8 +182,9 @@ fn param_table(out: &mut String, result: &FitResult) {
     }
     out.push_str("</tbody></table>\n");
     out.push_str(
-        "<p class=\"muted\">value ± standard error from s²(JᵀJ)⁻¹; \
-         <span class=\"bound\">!</span> = ended at a physical bound (its error is meaningless); \
+        "<p class=\"muted\">value ± the larger of the two standard errors, s²(JᵀJ)⁻¹ and the \
+         sandwich (heteroscedasticity-consistent) one; \
+         <span class=\"bound\">at bound</span> = ended at a physical bound (no standard error); \
          “all” = one parameter set fitted to every incidence at once. \
          RMS rel. = RMS of (model − data) ÷ √(data² + floor²).</p>\n",
     );
@@ -337,15 +338,19 @@ pub fn html(input: &ReportInput) -> String {
          <a href=\"#provenance\">Provenance</a></nav>\n",
     );
 
+    // With one incidence the all-incidence fit is that fit: its warnings
+    // once, not twice.
+    let global = result
+        .global
+        .iter()
+        .filter(|_| result.incidences.len() > 1)
+        .map(|r| (r, "all incidences".to_string()));
     let fit_warnings: Vec<String> = result
         .incidences
         .iter()
-        .chain(result.global.iter())
-        .flat_map(|r| {
-            r.warnings
-                .iter()
-                .map(move |w| format!("{} (θ_in {}°): {w}", r.source, num(r.theta_in)))
-        })
+        .map(|r| (r, format!("{} (θ_in {}°)", r.source, num(r.theta_in))))
+        .chain(global)
+        .flat_map(|(r, label)| r.warnings.iter().map(move |w| format!("{label}: {w}")))
         .collect();
     if !input.warnings.is_empty() || !fit_warnings.is_empty() {
         out.push_str(

@@ -3,8 +3,8 @@
 use crate::cmd::material::{parse_fresnel_k, parse_variant};
 use anyhow::{Result, bail};
 use brtf_fit::{
-    ColourConversion, FitConfig, FitSetOptions, Gate, Interpolation, Recipe, ResidualKind,
-    RobustLoss, ScaleRule, WeightRule,
+    ColourConversion, FitConfig, FitSetOptions, Gate, Interpolation, KnownReflectance, Recipe,
+    ResidualKind, RobustLoss, ScaleRule, WeightRule,
 };
 use brtf_gonio::Hemisphere;
 use brtf_model::{MaterialKind, Variant};
@@ -17,7 +17,7 @@ pub struct FitArgs {
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
     /// Model to fit: plastic, metal, trans, plastic2, metal2 or trans2.
-    #[arg(long, value_parser = parse_kind)]
+    #[arg(long, value_parser = |s: &str| s.parse::<MaterialKind>())]
     pub model: MaterialKind,
     /// Tie R = G = B (always so for single-channel data).
     #[arg(long)]
@@ -55,7 +55,7 @@ pub struct FitArgs {
     #[arg(long)]
     pub floor: Option<f64>,
     /// Robust loss: none, huber[:C] or cauchy[:C] (C in robust standard deviations).
-    #[arg(long, default_value = "none", value_parser = parse_loss)]
+    #[arg(long, default_value = "none", value_parser = |s: &str| s.parse::<RobustLoss>())]
     pub loss: RobustLoss,
     /// What three-channel files hold: CIE X, Y, Z (converted to Radiance
     /// RGB), or RGB already (files from brtf before it wrote true XYZ).
@@ -79,13 +79,16 @@ pub struct FitArgs {
     /// Drop samples whose value is below this (in the data's unit).
     #[arg(long)]
     pub min_value: Option<f64>,
+    /// Mask the pgII sample holder's shadow: φ_out 270 ± 15° at θ_out ≥ 70°.
+    #[arg(long)]
+    pub mask_holder: bool,
     /// Beam integral for raw-signal files (makes the fit absolute); overrides the file's.
     #[arg(long)]
     pub beam_integral: Option<f64>,
     /// A known directional-hemispherical reflectance `VALUE@THETA` (e.g.
     /// `0.85@30`) that makes a raw-signal fit absolute.
-    #[arg(long, value_parser = parse_rho)]
-    pub rho: Option<(f64, f64)>,
+    #[arg(long, value_parser = |s: &str| s.parse::<KnownReflectance>())]
+    pub rho: Option<KnownReflectance>,
     /// Fit a free overall scale even when the data are absolute.
     #[arg(long)]
     pub free_scale: bool,
@@ -141,45 +144,6 @@ pub enum InterpArg {
     Linear,
 }
 
-fn parse_kind(s: &str) -> Result<MaterialKind, String> {
-    s.parse()
-}
-
-fn parse_rho(s: &str) -> Result<(f64, f64), String> {
-    let (value, theta) = s
-        .split_once('@')
-        .ok_or("expected VALUE@THETA, e.g. 0.85@30")?;
-    let value: f64 = value
-        .parse()
-        .map_err(|_| format!("bad reflectance `{value}`"))?;
-    let theta: f64 = theta.parse().map_err(|_| format!("bad angle `{theta}`"))?;
-    if !(value > 0.0 && value <= 1.0 && (0.0..90.0).contains(&theta)) {
-        return Err("need 0 < VALUE ≤ 1 and 0 ≤ THETA < 90".into());
-    }
-    Ok((value, theta))
-}
-
-fn parse_loss(s: &str) -> Result<RobustLoss, String> {
-    let (name, c) = match s.split_once(':') {
-        Some((n, c)) => (
-            n,
-            Some(
-                c.parse::<f64>()
-                    .map_err(|_| format!("bad loss scale `{c}`"))?,
-            ),
-        ),
-        None => (s, None),
-    };
-    match name {
-        "none" => Ok(RobustLoss::None),
-        "huber" => Ok(RobustLoss::Huber(c.unwrap_or(1.345))),
-        "cauchy" => Ok(RobustLoss::Cauchy(c.unwrap_or(2.385))),
-        _ => Err(format!(
-            "expected none, huber[:C] or cauchy[:C], found `{s}`"
-        )),
-    }
-}
-
 impl FitArgs {
     /// The library's options for these arguments.
     pub fn options(&self, name: String) -> Result<FitSetOptions> {
@@ -207,6 +171,9 @@ impl FitArgs {
             });
         }
         selections.extend(self.min_value.map(|min| Gate::MinValue { min }));
+        if self.mask_holder {
+            selections.push(brtf_gonio::PGII_HOLDER_BAND);
+        }
         let mut config = FitConfig::new(self.model);
         config.options.variant = self.variant;
         config.options.fresnel_k = self.fresnel_k;
@@ -240,7 +207,7 @@ impl FitArgs {
                     WeightsArg::Uniform => WeightRule::Uniform,
                 },
             },
-            known_reflectance: self.rho,
+            known_reflectance: self.rho.map(|k| (k.rho, k.theta_in)),
             interpolation: match self.interpolation {
                 InterpArg::Pchip => Interpolation::Pchip,
                 InterpArg::Linear => Interpolation::Linear,

@@ -23,6 +23,9 @@ use plotters::prelude::*;
 
 /// Plane tolerances tried, degrees.
 const TOLERANCES: [f64; 6] = [0.25, 0.5, 1.0, 1.5, 2.0, 3.0];
+/// Width of the x bins of a cut, degrees: each shows its sample nearest
+/// the plane.
+const CUT_BIN_DEG: f64 = 0.25;
 /// Fitted samples a cut should hold.
 const ENOUGH: usize = 60;
 /// Decades shown below the top of the log axis.
@@ -134,11 +137,24 @@ impl<'a> CutData<'a> {
         });
         let back = inc.samples.iter().any(|s| s.used() && s.dir.z < 0.0);
         let range = if back { (-180.0, 180.0) } else { (-90.0, 90.0) };
-        let points: Vec<(f64, &PlotSample)> = near
+        // One sample per bin of x, the one nearest the plane: on dense
+        // layouts (pgII rings) the samples a few degrees off the plane sit
+        // below the in-plane values at the same x and draw a comb.
+        let mut nearest: std::collections::BTreeMap<i64, (f64, f64, &PlotSample)> =
+            std::collections::BTreeMap::new();
+        for (o, x, s) in near
             .into_iter()
             .filter(|(o, x, _)| *o <= tolerance && (range.0..=range.1).contains(x))
-            .map(|(_, x, s)| (x, s))
-            .collect();
+        {
+            let bin = (x / CUT_BIN_DEG).floor() as i64;
+            let slot = nearest.entry(bin).or_insert((o, x, s));
+            // Fitted samples first, then the nearest to the plane.
+            if (s.used(), -o) > (slot.2.used(), -slot.0) {
+                *slot = (o, x, s);
+            }
+        }
+        let points: Vec<(f64, &PlotSample)> =
+            nearest.into_values().map(|(_, x, s)| (x, s)).collect();
         let steps = if back { 2880 } else { 1440 };
         let curve = (0..=steps)
             .map(|k| {

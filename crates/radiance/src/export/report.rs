@@ -98,8 +98,10 @@ pub(crate) fn incidences(result: &FitResult) -> Vec<String> {
 }
 
 /// Caveats about a material: values outside the ranges Radiance's
-/// reference manual calls realistic, roughness 0, and energy.
-pub(crate) fn range_caveats(material: &Material) -> Vec<String> {
+/// reference manual calls realistic, roughness 0, and energy. With a free
+/// scale the specularity of the non-metals is relative (see
+/// [`scale_caveat`]), so it is not judged against the manual's range.
+pub(crate) fn range_caveats(material: &Material, free_scale: bool) -> Vec<String> {
     let kind = material.kind();
     let args = material.args();
     let spec = args[3];
@@ -112,7 +114,7 @@ pub(crate) fn range_caveats(material: &Material) -> Vec<String> {
                 sig(spec, 4)
             ));
         }
-    } else if spec > 0.1 {
+    } else if spec > 0.1 && !free_scale {
         let family = if kind.is_transmitting() {
             " (trans is \"similar to plastic\")"
         } else {
@@ -177,12 +179,30 @@ pub(crate) fn energy_caveats(material: &Material, options: &EvalOptions) -> Vec<
 
 /// A fit with a free overall scale (raw detector signal) fixes the colour
 /// at 1: the exported reflectance is relative, not absolute.
+///
+/// For metals the highlight is coloured, so scaling the colour by the
+/// instrument's scale K makes the material absolute. For plastic and
+/// trans the highlight is not: the fitted `spec` is a fraction of the
+/// unknown K too (absolute spec = K × spec), so neither it nor the colour
+/// is physical until K is known.
 pub(crate) fn scale_caveat(result: &FitResult) -> Option<String> {
+    let kind = result.config.kind;
     result.config.free_scale.then(|| {
-        "the fit had a free overall scale (raw signal of unknown scale): the colour is fixed \
-         at 1, so the absolute reflectance is unknown. Scale the colour arguments to a \
-         measured reflectance before using this material."
-            .to_string()
+        if kind.is_metal() {
+            "the fit had a free overall scale (raw signal of unknown scale): the colour is \
+             fixed at 1, so the absolute reflectance is unknown. Scale the colour arguments \
+             to a measured reflectance (or refit with --rho VALUE@THETA) before using this \
+             material."
+                .to_string()
+        } else {
+            format!(
+                "the fit had a free overall scale (raw signal of unknown scale): the colour is \
+                 fixed at 1 and spec is a fraction of that unknown scale, not {kind}'s physical \
+                 specularity (its highlight is not coloured, so scaling the colour alone is \
+                 wrong). Refit with --rho VALUE@THETA or --beam-integral B for physical colour \
+                 and specularity."
+            )
+        }
     })
 }
 
@@ -303,6 +323,9 @@ pub(crate) fn ascii(s: &str) -> String {
             'φ' => "phi".to_string(),
             '°' => " deg".to_string(),
             '≈' => "~".to_string(),
+            '÷' => "/".to_string(),
+            '×' => "x".to_string(),
+            '±' => "+-".to_string(),
             '≤' => "<=".to_string(),
             '≥' => ">=".to_string(),
             '…' => "...".to_string(),

@@ -195,7 +195,7 @@ pub(crate) fn text(result: &FitResult, chosen: &Chosen, name: &str, with_theta: 
             ));
         }
     }
-    caveats.extend(report::range_caveats(material));
+    caveats.extend(report::range_caveats(material, result.config.free_scale));
     caveats.extend(report::energy_caveats(material, &options));
     if kind.is_anisotropic() {
         let o = material.orientation();
