@@ -440,6 +440,11 @@ fn fmt_real(x: f64) -> String {
 
 /// Radiance text for a primitive, one argument list per line.
 pub fn format_primitive(p: &Primitive) -> String {
+    // `modifier alias name reference` has no argument lists.
+    if p.kind == "alias" {
+        let reference = p.strings.first().map_or("", String::as_str);
+        return format!("{} alias {} {reference}\n", p.modifier, p.name);
+    }
     let mut out = format!("{} {} {}\n", p.modifier, p.kind, p.name);
     out += &p.strings.len().to_string();
     for s in &p.strings {
