@@ -24,9 +24,10 @@ impl std::str::FromStr for RobustLoss {
     /// deviations; 1.345 and 2.385 by default, 95 % efficient).
     fn from_str(s: &str) -> Result<RobustLoss, String> {
         let (name, c) = match s.split_once(':') {
+            // The range is checked with the other options (`FitSetOptions::validate`).
             Some((n, c)) => match c.parse::<f64>() {
-                Ok(c) if c.is_finite() && c > 0.0 => (n, Some(c)),
-                _ => return Err(format!("bad loss scale `{c}`: need a number above 0")),
+                Ok(c) => (n, Some(c)),
+                Err(_) => return Err(format!("bad loss scale `{c}`")),
             },
             None => (s, None),
         };
