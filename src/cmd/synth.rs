@@ -1,10 +1,11 @@
 //! `brtf synth`: synthetic measurement files with instrument effects.
 
-use super::material::MaterialArgs;
+use super::material::{MaterialArgs, parse_fresnel_k, parse_variant};
 use super::output::write_atomic;
-use anyhow::{Context, Result, bail};
-use brtf_gonio::synth::{GroundTruth, Instrument, Layout, SynthSpec, synthesize};
-use brtf_gonio::{Channels, Incidence, SourceFormat};
+use anyhow::{Result, bail};
+use brtf_gonio::synth::{GroundTruth, Instrument, Layout, SYNTH_MARKER, SynthSet};
+use brtf_gonio::{Channels, SourceFormat};
+use brtf_model::Variant;
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 
@@ -77,9 +78,6 @@ pub struct SynthArgs {
     pub force: bool,
 }
 
-/// The header line that marks brtf synth's own files (which it may replace).
-const SYNTH_MARKER: &str = "synth (synthetic data, not a measurement)";
-
 /// The model options of `--material` (same spellings as `brtf eval`).
 #[derive(Args, Debug)]
 pub struct SynthModelArgs {
@@ -87,11 +85,11 @@ pub struct SynthModelArgs {
     #[arg(long)]
     pub name: Option<String>,
     /// Formula set of the material.
-    #[arg(long, default_value = "radiance")]
-    pub variant: String,
+    #[arg(long, default_value = "radiance", value_parser = parse_variant)]
+    pub variant: Variant,
     /// Fresnel constant: classic, pyradiance or a number.
-    #[arg(long, default_value = "classic")]
-    pub fresnel_k: String,
+    #[arg(long, default_value = "classic", value_parser = parse_fresnel_k)]
+    pub fresnel_k: f64,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -106,125 +104,81 @@ pub fn run(args: SynthArgs) -> Result<()> {
             let material = MaterialArgs {
                 material: path.clone(),
                 name: args.model.name.clone(),
-                variant: args.model.variant.parse().map_err(anyhow::Error::msg)?,
-                fresnel_k: match args.model.fresnel_k.as_str() {
-                    "classic" => brtf_model::FRESNEL_K_CLASSIC,
-                    "pyradiance" => brtf_model::FRESNEL_K_PYRADIANCE,
-                    k => k
-                        .parse()
-                        .context("--fresnel-k: expected classic, pyradiance or a number")?,
-                },
+                variant: args.model.variant,
+                fresnel_k: args.model.fresnel_k,
                 source_omega: 0.0,
                 curved: false,
             };
             GroundTruth::Model(material.bsdf()?)
         }
         (None, Some(f0)) => {
-            if f0.len() != 3 || args.ggx_diffuse.len() != 3 {
+            let (Ok(f0), Ok(diffuse)) = (
+                <[f64; 3]>::try_from(&f0[..]),
+                <[f64; 3]>::try_from(&args.ggx_diffuse[..]),
+            ) else {
                 bail!("--ggx and --ggx-diffuse take three numbers r,g,b");
-            }
+            };
             if !(args.ggx_alpha > 0.0 && args.ggx_alpha <= 1.0) {
                 bail!("--ggx-alpha must be in (0, 1]");
             }
             GroundTruth::Ggx {
-                f0: [f0[0], f0[1], f0[2]],
+                f0,
                 alpha: args.ggx_alpha,
-                diffuse: [
-                    args.ggx_diffuse[0],
-                    args.ggx_diffuse[1],
-                    args.ggx_diffuse[2],
-                ],
+                diffuse,
             }
         }
         _ => bail!("give the ground truth: --material M.rad or --ggx R,G,B"),
     };
-    let channels = match args.channels {
-        1 => Channels::Y,
-        3 => Channels::Xyz,
-        n => bail!("--channels must be 1 or 3, not {n}"),
-    };
-    if matches!(args.format, FormatArg::Mpc) && channels == Channels::Xyz {
-        bail!("the .mpc format holds one value per row; use --format mountain for --channels 3");
-    }
-    brtf_model::OptionError::check("--phi-in", args.phi_in, args.phi_in.is_finite(), "finite")?;
-    let instrument = Instrument {
-        source_aperture_deg: args.source_aperture,
-        detector_aperture_deg: args.detector_aperture,
-        noise_relative: args.noise,
-        noise_floor: args.noise_floor,
-        blind_spot_deg: args.blind_spot,
-        holder_gap: !args.no_holder_gap,
-        back_rows: !args.no_back_rows,
-        aperture_rays: 3,
-    };
-    let layout = Layout {
-        coarse_step_deg: args.coarse_step,
-        fine_step_deg: args.fine_step,
-        max_theta_deg: 88.0,
-    };
-    instrument.validate()?;
-    layout.validate()?;
-    let prefix = args.prefix.clone().unwrap_or_else(|| {
-        args.out
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_else(|| "synth".into())
-    });
-    // The prefix names files and goes into the header as the sample name.
-    if prefix.is_empty() || prefix.contains(['/', '\\']) || prefix.contains(char::is_control) {
-        bail!(
-            "--prefix {prefix:?}: must be one line without / or \\ (it names files and the sample)"
-        );
-    }
-    let ext = match args.format {
-        FormatArg::Mpc => "mpc",
-        FormatArg::Mountain => "txt",
-    };
-    let file_of = |theta: f64| {
-        args.out
-            .join(format!("{prefix}:{:+}{:+}.{ext}", theta, args.phi_in))
-    };
-    for &theta in &args.theta_in {
-        let ok = (0.0..90.0).contains(&theta);
-        brtf_model::OptionError::check("--theta-in", theta, ok, "0 ≤ θ_in < 90 degrees")?;
-        let inputs: Vec<&std::path::Path> = args.material.iter().map(|m| m.as_path()).collect();
-        brtf_io::check_overwrite(&file_of(theta), &inputs, Some(SYNTH_MARKER), args.force)?;
-    }
-    for (index, &theta) in args.theta_in.iter().enumerate() {
-        let spec = SynthSpec {
-            truth,
-            incidence: Incidence::new(theta, args.phi_in),
-            instrument: instrument.clone(),
-            layout: layout.clone(),
-            channels,
-            seed: args.seed.wrapping_add(index as u64),
-            sample_name: prefix.clone(),
-        };
-        let mut m = synthesize(&spec);
-        let format = match args.format {
+    let set = SynthSet {
+        truth,
+        theta_in: args.theta_in.clone(),
+        phi_in: args.phi_in,
+        instrument: Instrument {
+            source_aperture_deg: args.source_aperture,
+            detector_aperture_deg: args.detector_aperture,
+            noise_relative: args.noise,
+            noise_floor: args.noise_floor,
+            blind_spot_deg: args.blind_spot,
+            holder_gap: !args.no_holder_gap,
+            back_rows: !args.no_back_rows,
+            aperture_rays: 3,
+        },
+        layout: Layout {
+            coarse_step_deg: args.coarse_step,
+            fine_step_deg: args.fine_step,
+            max_theta_deg: 88.0,
+        },
+        channels: match args.channels {
+            1 => Channels::Y,
+            3 => Channels::Xyz,
+            n => bail!("--channels must be 1 or 3, not {n}"),
+        },
+        format: match args.format {
             FormatArg::Mpc => SourceFormat::Mpc,
             FormatArg::Mountain => SourceFormat::Mountain,
-        };
-        m.format = format;
-        m.header = vec![
-            format!(
-                "#generated by brtf {} {SYNTH_MARKER}",
-                env!("CARGO_PKG_VERSION")
-            ),
-            // One header line whatever the arguments hold.
-            format!(
-                "#command: {}",
-                std::env::args().collect::<Vec<_>>().join(" ")
-            )
-            .replace(char::is_control, " "),
-        ];
-        let text = match format {
-            SourceFormat::Mpc => brtf_gonio::to_mpc_string(&m).map_err(anyhow::Error::msg)?,
-            SourceFormat::Mountain => brtf_gonio::to_mountain_string(&m),
-        };
-        let file = file_of(theta);
+        },
+        seed: args.seed,
+        prefix: args.prefix.clone().unwrap_or_else(|| {
+            args.out
+                .file_name()
+                .map_or_else(|| "synth".into(), |n| n.to_string_lossy().into_owned())
+        }),
+        header: vec![format!(
+            "#command: {}",
+            std::env::args().collect::<Vec<_>>().join(" ")
+        )],
+    };
+    set.validate()?;
+    let inputs: Vec<&std::path::Path> = args.material.iter().map(|m| m.as_path()).collect();
+    for &theta in &set.theta_in {
+        let file = args.out.join(set.file_name(theta));
+        brtf_io::check_overwrite(&file, &inputs, Some(SYNTH_MARKER), args.force)?;
+    }
+    for (index, &theta) in set.theta_in.iter().enumerate() {
+        let (text, samples) = set.file_text(index).map_err(anyhow::Error::msg)?;
+        let file = args.out.join(set.file_name(theta));
         write_atomic(&file, text.as_bytes())?;
-        eprintln!("wrote {} ({} samples)", file.display(), m.samples.len());
+        eprintln!("wrote {} ({samples} samples)", file.display());
     }
     Ok(())
 }

@@ -527,7 +527,7 @@ fn every_bad_number_is_refused_in_one_line_before_any_work() {
         (synth(&["--noise=-1"]), "--noise -1: out of range"),
         (
             synth(&["--prefix", "a\n#injected: 1"]),
-            "--prefix \"a\\n#injected: 1\": must be one line",
+            "--prefix \"a\\n#injected: 1\": out of range; allowed: one line",
         ),
         (gonio(&["--theta-in", "90"]), "--theta-in 90: out of range"),
         (
