@@ -109,7 +109,7 @@ pub enum ParseErrorKind {
         text: String,
     },
     /// An angle lies outside its valid range (θ must be in [0°, 180°]).
-    #[error("{what} = {value} is outside [{min}, {max}] degrees")]
+    #[error("{what} = {} is outside [{min}, {max}] degrees", short_number(*value))]
     AngleOutOfRange {
         /// Which angle, e.g. `theta_out`.
         what: &'static str,
@@ -243,4 +243,14 @@ pub enum ConvertError {
         /// Why.
         reason: &'static str,
     },
+}
+
+/// A number for messages: as written for ordinary magnitudes, in exponent
+/// form for huge or tiny ones (`1e308`, not 309 digits).
+fn short_number(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() || (1e-4..1e9).contains(&v.abs()) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
 }
