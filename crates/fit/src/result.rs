@@ -207,6 +207,15 @@ impl FitResult {
                 ));
             }
         }
+        for r in &self.incidences {
+            let incidence = (0.0..=180.0).contains(&r.theta_in) && r.phi_in.is_finite();
+            if !incidence || r.phi_in.abs() > 720.0 {
+                return Err(format!(
+                    "{}: incidence θ_in {:.6e}, φ_in {:.6e} is not one a file can hold",
+                    r.source, r.theta_in, r.phi_in
+                ));
+            }
+        }
         let n = self.config.kind.param_names().len();
         for r in self.incidences.iter().chain(&self.global) {
             if r.material_args.len() != n || !r.material_args.iter().all(|a| a.is_finite()) {

@@ -112,8 +112,10 @@ impl ParamTable {
                 self.theta_in.len()
             ));
         }
-        if !self.theta_in.iter().all(|t| t.is_finite()) {
-            return invalid("a θ_in is not a finite number".into());
+        if let Some(t) = self.theta_in.iter().find(|t| !(0.0..=180.0).contains(*t)) {
+            return invalid(format!(
+                "θ_in {t:.6e} is not an incidence in [0, 180] degrees"
+            ));
         }
         if let Some(w) = self.theta_in.windows(2).find(|w| w[1] <= w[0]) {
             return invalid(format!("θ_in is not ascending at {}° → {}°", w[0], w[1]));
