@@ -48,7 +48,6 @@ pub struct CheckArgs {
 }
 
 pub fn run(args: CheckArgs) -> Result<()> {
-    let fit = read_fit(&args.dir)?;
     let apex = |a: Option<f64>| a.map(brtf_model::cone_solid_angle);
     let options = CheckOptions {
         samples: args.samples,
@@ -62,6 +61,8 @@ pub fn run(args: CheckArgs) -> Result<()> {
         seed: args.seed,
         search_dirs: args.search_dirs.clone(),
     };
+    options.validate()?;
+    let fit = read_fit(&args.dir)?;
     let report = with_jobs(args.jobs, || check_fit(&fit, &args.dir, &options))??;
     super::output::print(&report.to_string())?;
     let out = args

@@ -487,7 +487,21 @@ fn every_bad_number_is_refused_in_one_line_before_any_work() {
         a.extend_from_slice(extra);
         a.into_iter().map(String::from).collect()
     };
+    let check = |extra: &[&str]| -> Vec<String> {
+        let mut a = vec!["check", "nowhere"];
+        a.extend_from_slice(extra);
+        a.into_iter().map(String::from).collect()
+    };
     let cases: Vec<(Vec<String>, &str)> = vec![
+        (
+            check(&["--intermediate", "1000000000"]),
+            "--intermediate 1000000000: out of range",
+        ),
+        (check(&["--samples", "0"]), "--samples 0: out of range"),
+        (
+            check(&["--detector-omega", "7"]),
+            "--detector-omega 7: out of range",
+        ),
         (
             fit(&["--source-omega", "100"]),
             "--source-omega 100: out of range; allowed: 0 ≤ ω ≤ 2π",

@@ -59,6 +59,41 @@ impl Default for CheckOptions {
     }
 }
 
+impl CheckOptions {
+    /// Checks the numbers before any work, naming the option: 1 to 10⁶
+    /// rays per direction, 1 to 10⁷ directions, at most 100 intermediate
+    /// incidences per interval, solid angles from 0 to 2π sr.
+    pub fn validate(&self) -> Result<(), brtf_model::OptionError> {
+        use brtf_model::OptionError;
+        let samples = f64::from(self.samples);
+        OptionError::check(
+            "--samples",
+            samples,
+            (1.0..=1e6).contains(&samples),
+            "1 to 1,000,000",
+        )?;
+        let directions = self.max_directions as f64;
+        let ok = (1.0..=1e7).contains(&directions);
+        OptionError::check("--max-directions", directions, ok, "1 to 10,000,000")?;
+        let intermediate = self.intermediate as f64;
+        OptionError::check(
+            "--intermediate",
+            intermediate,
+            intermediate <= 100.0,
+            "0 to 100",
+        )?;
+        let hemisphere = 2.0 * std::f64::consts::PI;
+        for (option, omega) in [
+            ("--source-omega", self.source_omega.unwrap_or(0.0)),
+            ("--detector-omega", self.detector_omega),
+        ] {
+            let ok = (0.0..=hemisphere).contains(&omega);
+            OptionError::check(option, omega, ok, "0 to 2π sr")?;
+        }
+        Ok(())
+    }
+}
+
 /// Why a check could not run.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
