@@ -499,6 +499,35 @@ fn every_bad_number_is_refused_in_one_line_before_any_work() {
         ),
         (check(&["--samples", "0"]), "--samples 0: out of range"),
         (
+            [
+                "render",
+                "image",
+                "--material",
+                m,
+                "--out",
+                "never",
+                "--exposure=-1",
+            ]
+            .map(String::from)
+            .to_vec(),
+            "--exposure -1: out of range",
+        ),
+        (
+            [
+                "render",
+                "image",
+                "--material",
+                m,
+                "--out",
+                "never",
+                "--samples",
+                "100000000",
+            ]
+            .map(String::from)
+            .to_vec(),
+            "--samples 100000000: out of range",
+        ),
+        (
             check(&["--detector-omega", "7"]),
             "--detector-omega 7: out of range",
         ),

@@ -170,6 +170,22 @@ impl ImageArgs {
 pub fn run(args: ImageArgs) -> Result<()> {
     let spec = args.spec();
     spec.validate()?;
+    let samples = f64::from(args.samples);
+    let check = brtf_model::OptionError::check;
+    check(
+        "--samples",
+        samples,
+        (1.0..=65536.0).contains(&samples),
+        "1 to 65536",
+    )?;
+    if let Some(e) = args.exposure {
+        check(
+            "--exposure",
+            e,
+            e.is_finite() && e > 0.0,
+            "a number above 0",
+        )?;
+    }
     for ext in [".hdr", ".png", ".rad", ".vf"] {
         let inputs: Vec<&std::path::Path> =
             args.sample.material.iter().map(|m| m.as_path()).collect();
