@@ -2,6 +2,15 @@
 //! Physics lives in `brtf-model`, file formats in `brtf-gonio`, Radiance
 //! text in `brtf-radiance`.
 
+/// `eprintln!` that does not panic when standard error cannot be written
+/// (closed, or a full device): the message is dropped, the run goes on.
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), $($arg)*);
+    }};
+}
+
 mod cmd;
 
 use clap::{Parser, Subcommand};
@@ -59,7 +68,7 @@ fn main() {
         if cmd::output::is_broken_pipe(&err) {
             std::process::exit(0);
         }
-        eprintln!("brtf: error: {err:#}");
+        say!("brtf: error: {err:#}");
         std::process::exit(1);
     }
 }

@@ -70,6 +70,6 @@ pub fn run(args: CheckArgs) -> Result<()> {
         .clone()
         .unwrap_or_else(|| args.dir.join("check.csv"));
     write_atomic(&out, report.csv()?.as_bytes())?;
-    eprintln!("brtf check: wrote {}", out.display());
+    say!("brtf check: wrote {}", out.display());
     Ok(())
 }

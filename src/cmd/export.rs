@@ -60,7 +60,7 @@ pub fn run(args: ExportArgs) -> Result<()> {
     }
     update.commit()?;
     for note in &exported.notes {
-        eprintln!("note: {note}");
+        say!("note: {note}");
     }
     print(&lines)
 }

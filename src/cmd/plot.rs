@@ -54,7 +54,7 @@ pub fn run(args: PlotArgs) -> Result<()> {
     relist(update.path(), &written.files, Producer::Plot)?;
     update.commit()?;
     for w in &written.warnings {
-        eprintln!("brtf: warning: {w}");
+        say!("brtf: warning: {w}");
     }
     print(&format!(
         "brtf plot: {} files in {:.2} s -> {}\n",

@@ -178,7 +178,7 @@ pub fn run(args: SynthArgs) -> Result<()> {
         let (text, samples) = set.file_text(index).map_err(anyhow::Error::msg)?;
         let file = args.out.join(set.file_name(theta));
         write_atomic(&file, text.as_bytes())?;
-        eprintln!("wrote {} ({samples} samples)", file.display());
+        say!("wrote {} ({samples} samples)", file.display());
     }
     Ok(())
 }

@@ -440,6 +440,41 @@ fn a_closed_pipe_exits_quietly_and_a_full_disk_says_so_in_one_line() {
             assert_eq!(err.lines().count(), 1, "{err}");
         }
         assert_whole(&out);
+        // A full standard error loses the messages, not the run: a fit
+        // with warnings and progress still writes its folder.
+        let full = std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .unwrap();
+        let o = command(root.path(), &fit_args(&files, s(&out), &["--no-plots"]))
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(full)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(0), "a full stderr ended the fit");
+        assert_whole(&out);
+        // brtf synth reports every file on stderr (it panicked there).
+        let full = std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .unwrap();
+        let synth = [
+            "synth",
+            "--ggx",
+            "0.9,0.9,0.9",
+            "--theta-in",
+            "30",
+            "--out",
+            "quiet",
+        ];
+        let o = command(root.path(), &synth)
+            .stdin(Stdio::null())
+            .stderr(full)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(0), "a full stderr ended brtf synth");
+        assert!(root.path().join("quiet/quiet:+30+0.mpc").is_file());
     }
 }
 

@@ -91,10 +91,10 @@ pub fn run(args: FitArgs) -> Result<()> {
     result.write(stage).with_context(context)?;
     update.commit()?;
     for warning in &result.warnings {
-        eprintln!("brtf: warning: {warning}");
+        say!("brtf: warning: {warning}");
     }
     for note in &notes {
-        eprintln!("{note}");
+        say!("{note}");
     }
     print(&format!("{}{lines}", brtf_fit::summary(&result, &out)))
 }

@@ -146,7 +146,7 @@ pub fn run(args: GonioArgs) -> Result<()> {
     let start = std::time::Instant::now();
     let (values, rays) = with_jobs(args.jobs, || gonio.render(&dirs))?;
     let elapsed = start.elapsed().as_secs_f64();
-    eprintln!(
+    say!(
         "brtf render gonio: {} directions × {} rays, {:.2} M rays in {:.2} s ({:.2} M rays/s)",
         dirs.len(),
         setup.samples,

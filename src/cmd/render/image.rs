@@ -197,7 +197,7 @@ pub fn run(args: ImageArgs) -> Result<()> {
     let options = spec.image_options(args.samples, !args.no_jitter, args.seed);
     let rendered = with_jobs(args.jobs, || brtf_trace::render(&scene, &camera, &options))?;
     let secs = rendered.elapsed.as_secs_f64();
-    eprintln!(
+    say!(
         "brtf render image: {}×{} × {} samples, {:.2} M rays ({} camera, {} shadow, {} secondary) in {:.2} s ({:.2} M rays/s)",
         args.width,
         args.height,
@@ -238,7 +238,7 @@ pub fn run(args: ImageArgs) -> Result<()> {
         write_atomic(&args.with_ext(".rad"), rad.as_bytes())?;
         write_atomic(&args.with_ext(".vf"), format!("{view}\n").as_bytes())?;
         if is_table {
-            eprintln!(
+            say!(
                 "brtf render image: note: {}.rad holds the fit's static material; brtf-trace rendered its θ_in table",
                 args.out.display()
             );
