@@ -195,6 +195,120 @@ pub enum ParseErrorKind {
     /// The file has a header but no data rows.
     #[error("no data rows")]
     NoData,
+    /// A Klems BSDF XML file that brtf cannot read; `element` is the XML
+    /// element the problem was found in.
+    #[error("<{element}>: {problem}")]
+    Klems {
+        /// The element's local name, e.g. `ScatteringData`.
+        element: String,
+        /// What is wrong.
+        problem: KlemsProblem,
+    },
+}
+
+/// What is wrong with a Klems BSDF XML file (see [`ParseErrorKind::Klems`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum KlemsProblem {
+    /// The text is not well-formed XML.
+    #[error("not well-formed XML: {0}")]
+    Xml(String),
+    /// The root element is not `WindowElement`.
+    #[error("not a BSDF XML file: the root element is <{0}>, not <WindowElement>")]
+    NotWindowElement(String),
+    /// A required child element is missing.
+    #[error("missing <{0}>")]
+    Missing(&'static str),
+    /// The data are a tensor tree, not a Klems matrix.
+    #[error("not supported yet: tensor tree (`{0}`); only Klems matrices (Columns or Rows) are")]
+    TensorTree(String),
+    /// `IncidentDataStructure` is neither `Columns` nor `Rows`.
+    #[error("unknown data structure `{0}` (expected Columns or Rows)")]
+    UnknownStructure(String),
+    /// A basis name that neither the file nor the built-in Klems bases define.
+    #[error(
+        "unknown basis `{0}` (known: LBNL/Klems Full, LBNL/Klems Half, LBNL/Klems Quarter, \
+         or an AngleBasis defined in the file)"
+    )]
+    UnknownBasis(String),
+    /// An `AngleBasis` whose blocks do not make a valid basis.
+    #[error("basis `{name}`: {reason}")]
+    BadBasis {
+        /// The basis name.
+        name: String,
+        /// Why.
+        reason: String,
+    },
+    /// Column and row bases differ; brtf reads square matrices only.
+    #[error("column basis `{column}` and row basis `{row}` differ (only square matrices are read)")]
+    MismatchedBases {
+        /// `ColumnAngleBasis`.
+        column: String,
+        /// `RowAngleBasis`.
+        row: String,
+    },
+    /// A `WavelengthDataDirection` that is none of the four.
+    #[error(
+        "unknown direction `{0}` (expected Transmission Front, Transmission Back, \
+         Reflection Front or Reflection Back)"
+    )]
+    UnknownDirection(String),
+    /// The matrix has the wrong number of values.
+    #[error("{what}: expected {expected} values ({n} x {n}), found {found}")]
+    TokenCount {
+        /// Band and direction, e.g. `Visible Transmission Front`.
+        what: String,
+        /// N².
+        expected: usize,
+        /// N.
+        n: usize,
+        /// Values found.
+        found: usize,
+    },
+    /// A matrix value is not a finite number.
+    #[error("{what}: value {index} is `{text}`, not a finite number")]
+    NotANumber {
+        /// Band and direction.
+        what: String,
+        /// 1-based position in the matrix text.
+        index: usize,
+        /// The text (at most 40 characters).
+        text: String,
+    },
+    /// A matrix value below −1e-3 (Radiance's wrapBSDF refuses these too;
+    /// smaller negative values are read as 0, as Radiance does).
+    #[error("{what}: value {value} at row {row}, column {column} is negative (below -1e-3)")]
+    Negative {
+        /// Band and direction.
+        what: String,
+        /// The value.
+        value: f64,
+        /// 1-based row of the text.
+        row: usize,
+        /// 1-based column of the text.
+        column: usize,
+    },
+    /// A number in the header or basis that cannot be read.
+    #[error("expected {expected}, found `{text}`")]
+    BadValue {
+        /// What was expected.
+        expected: &'static str,
+        /// The text found.
+        text: String,
+    },
+    /// The same band and direction twice.
+    #[error("{0} appears twice")]
+    Duplicate(String),
+    /// No `WavelengthData` block with a Klems matrix.
+    #[error("no WavelengthData block with a scattering matrix")]
+    NoData,
+    /// A Klems file holds many incidences; the one-measurement readers
+    /// cannot return it.
+    #[error(
+        "a Klems BSDF XML file holds one measurement per incident patch and side; \
+         read it with brtf_gonio::klems (brtf info reads it)"
+    )]
+    ManyIncidences,
 }
 
 /// Writing a measurement failed.

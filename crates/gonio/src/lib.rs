@@ -43,6 +43,7 @@
 pub mod convert;
 pub mod error;
 pub mod integral;
+pub mod klems;
 pub mod measurement;
 pub mod read;
 pub mod select;
@@ -53,7 +54,7 @@ mod synth_limits;
 pub mod write;
 
 pub use convert::{Converted, GRAZING_COS_LIMIT};
-pub use error::{ConvertError, ParseErrorKind, ReadError, WriteError};
+pub use error::{ConvertError, KlemsProblem, ParseErrorKind, ReadError, WriteError};
 pub use integral::{HemisphereIntegral, hemispherical_integral};
 pub use measurement::{
     BeamReference, Channels, Hemisphere, Incidence, IncidenceOrigin, Measurement, MpcColumns,
@@ -61,8 +62,8 @@ pub use measurement::{
     direction_from_degrees, normalize_phi_deg,
 };
 pub use read::{
-    detect_format, incidence_from_file_name, read_bytes, read_bytes_as, read_path, read_path_as,
-    read_str,
+    detect_format, incidence_from_file_name, is_xml, read_bytes, read_bytes_as, read_path,
+    read_path_as, read_str,
 };
 pub use select::{DEFAULT_THETA_CAP_DEG, Gate, GateContext, PGII_HOLDER_BAND, Selection};
 pub use solid_angle::{SolidAngleSource, SolidAngles, compute_solid_angles, solid_angles};

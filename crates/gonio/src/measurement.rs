@@ -38,6 +38,11 @@ pub enum SourceFormat {
     /// pab-opto "Mountain" (pgII): `theta phi value [value value]` rows with
     /// `#key value` header lines.
     Mountain,
+    /// Klems BSDF XML (LBNL/WINDOW): each measurement is one incident
+    /// patch of one side, and its values are **patch averages** (BSDF
+    /// averaged over each outgoing patch), not point values. Read with
+    /// [`crate::klems`]; not written by the gonio writers.
+    KlemsXml,
 }
 
 impl std::fmt::Display for SourceFormat {
@@ -45,6 +50,7 @@ impl std::fmt::Display for SourceFormat {
         f.write_str(match self {
             SourceFormat::Mpc => "ISE .mpc",
             SourceFormat::Mountain => "pab-opto Mountain",
+            SourceFormat::KlemsXml => "Klems BSDF XML (patch averages)",
         })
     }
 }

@@ -426,6 +426,7 @@ impl SynthSet {
         let ext = match self.format {
             SourceFormat::Mpc => "mpc",
             SourceFormat::Mountain => "txt",
+            SourceFormat::KlemsXml => "xml",
         };
         format!("{}:{theta:+}{:+}.{ext}", self.prefix, self.phi_in)
     }
@@ -453,6 +454,9 @@ impl SynthSet {
         let text = match self.format {
             SourceFormat::Mpc => crate::to_mpc_string(&m)?,
             SourceFormat::Mountain => crate::to_mountain_string(&m),
+            SourceFormat::KlemsXml => {
+                return Err("brtf synth writes .mpc or Mountain files, not Klems XML".into());
+            }
         };
         Ok((text, m.samples.len()))
     }

@@ -9,6 +9,7 @@ mod common;
 mod convert;
 mod encoding;
 mod integral;
+mod klems;
 mod measurement;
 mod read;
 mod robustness;

@@ -63,6 +63,15 @@ pub fn read_bytes_as(
     match format {
         SourceFormat::Mpc => mpc::parse(&text, name),
         SourceFormat::Mountain => mountain::parse(&text, name),
+        // One file, many incidences: `crate::klems` reads it.
+        SourceFormat::KlemsXml => Err(parse_error(
+            name,
+            1,
+            ParseErrorKind::Klems {
+                element: "WindowElement".into(),
+                problem: crate::error::KlemsProblem::ManyIncidences,
+            },
+        )),
     }
 }
 
@@ -70,13 +79,18 @@ pub fn read_bytes_as(
 /// or `#intheta` line means Mountain, which `.mpc` files never have; a
 /// `#using beam file`, `#incident angle …` or `#theta phi beam-ref …` line
 /// means `.mpc`); else the column count of the first data row (8 means
-/// `.mpc`). Defaults to Mountain.
+/// `.mpc`). Defaults to Mountain. An `.xml` extension, or text starting
+/// with `<`, is Klems BSDF XML.
 pub fn detect_format(bytes: &[u8], name: &Path) -> SourceFormat {
-    let has_mpc_extension = name
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("mpc"));
-    if has_mpc_extension {
+    let extension_is = |ext: &str| {
+        name.extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case(ext))
+    };
+    if extension_is("mpc") {
         return SourceFormat::Mpc;
+    }
+    if extension_is("xml") || is_xml(bytes) {
+        return SourceFormat::KlemsXml;
     }
     // Only the head of the file matters, and only its ASCII keys.
     let head = &bytes[..bytes.len().min(64 * 1024)];
@@ -114,7 +128,14 @@ pub fn detect_format(bytes: &[u8], name: &Path) -> SourceFormat {
     }
 }
 
-fn read_file(path: &Path) -> Result<Vec<u8>, ReadError> {
+/// True when the first non-blank character (after a UTF-8 byte-order
+/// mark) is `<`: gonio text files never start so.
+pub fn is_xml(bytes: &[u8]) -> bool {
+    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    bytes.iter().find(|b| !b.is_ascii_whitespace()) == Some(&b'<')
+}
+
+pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>, ReadError> {
     std::fs::read(path).map_err(|source| ReadError::Io {
         path: path.to_path_buf(),
         source,
@@ -132,7 +153,7 @@ pub(crate) fn parse_error(name: &Path, line: usize, kind: ParseErrorKind) -> Rea
 
 /// Rejects empty and binary input and returns the text (without a BOM),
 /// with lines that are not UTF-8 read as Latin-1.
-fn check_text<'a>(bytes: &'a [u8], name: &Path) -> Result<Cow<'a, str>, ReadError> {
+pub(crate) fn check_text<'a>(bytes: &'a [u8], name: &Path) -> Result<Cow<'a, str>, ReadError> {
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
     if bytes.iter().all(u8::is_ascii_whitespace) {
         return Err(parse_error(name, 1, ParseErrorKind::Empty));

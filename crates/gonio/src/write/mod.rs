@@ -31,6 +31,11 @@ pub fn write_path(
     match format {
         SourceFormat::Mpc => write_mpc(measurement, path),
         SourceFormat::Mountain => write_mountain(measurement, path),
+        SourceFormat::KlemsXml => Err(WriteError::Unsupported {
+            path: path.to_path_buf(),
+            format,
+            reason: "brtf does not write Klems BSDF XML yet".into(),
+        }),
     }
 }
 

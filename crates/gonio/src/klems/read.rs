@@ -1,0 +1,429 @@
+//! The Klems BSDF XML reader (roxmltree DOM; elements matched by local
+//! name, so the `http://windows.lbl.gov` namespace may be present or not).
+//!
+//! Only the first `Optical/Layer` is read, as Radiance does. Errors carry
+//! the file, the line of the element at fault and its name.
+
+use std::path::Path;
+
+use roxmltree::{Document, Node};
+
+use super::{
+    KlemsBand, KlemsBasis, KlemsBsdf, KlemsDirection, KlemsHeader, KlemsMatrix, KlemsRing,
+    NEGATIVE_LIMIT,
+};
+use crate::error::{KlemsProblem, ParseErrorKind, ReadError};
+use crate::read::{check_text, parse_error, read_file};
+
+/// Reads a Klems BSDF XML file.
+pub fn read_path(path: &Path) -> Result<KlemsBsdf, ReadError> {
+    let bytes = read_file(path)?;
+    read_bytes(&bytes, path)
+}
+
+/// Parses in-memory bytes; `name` is used in errors.
+pub fn read_bytes(bytes: &[u8], name: impl AsRef<Path>) -> Result<KlemsBsdf, ReadError> {
+    let name = name.as_ref();
+    let text = check_text(bytes, name)?;
+    read_str(&text, name)
+}
+
+/// Parses in-memory text; `name` is used in errors.
+pub fn read_str(text: &str, name: impl AsRef<Path>) -> Result<KlemsBsdf, ReadError> {
+    let name = name.as_ref();
+    let doc = Document::parse(text).map_err(|e| {
+        let line = (e.pos().row as usize).max(1);
+        parse_error(
+            name,
+            line,
+            ParseErrorKind::Klems {
+                element: "?xml".into(),
+                problem: KlemsProblem::Xml(e.to_string()),
+            },
+        )
+    })?;
+    Reader { doc: &doc, name }.read()
+}
+
+struct Reader<'a, 'input> {
+    doc: &'a Document<'input>,
+    name: &'a Path,
+}
+
+/// Element children of `node` with local name `tag`.
+fn children<'a, 'input: 'a>(
+    node: Node<'a, 'input>,
+    tag: &'static str,
+) -> impl Iterator<Item = Node<'a, 'input>> {
+    node.children()
+        .filter(move |c| c.is_element() && c.tag_name().name() == tag)
+}
+
+fn child<'a, 'input>(node: Node<'a, 'input>, tag: &'static str) -> Option<Node<'a, 'input>> {
+    children(node, tag).next()
+}
+
+/// The trimmed text of a child, `None` when absent or empty.
+fn child_text(node: Node<'_, '_>, tag: &'static str) -> Option<String> {
+    let text = child(node, tag)?.text()?.trim();
+    (!text.is_empty()).then(|| text.to_string())
+}
+
+impl<'a, 'input> Reader<'a, 'input> {
+    fn line_of(&self, node: Node<'_, '_>) -> usize {
+        (self.doc.text_pos_at(node.range().start).row as usize).max(1)
+    }
+
+    fn error(&self, node: Node<'_, '_>, problem: KlemsProblem) -> ReadError {
+        parse_error(
+            self.name,
+            self.line_of(node),
+            ParseErrorKind::Klems {
+                element: node.tag_name().name().to_string(),
+                problem,
+            },
+        )
+    }
+
+    fn required(
+        &self,
+        parent: Node<'a, 'input>,
+        tag: &'static str,
+    ) -> Result<Node<'a, 'input>, ReadError> {
+        child(parent, tag).ok_or_else(|| self.error(parent, KlemsProblem::Missing(tag)))
+    }
+
+    fn read(&self) -> Result<KlemsBsdf, ReadError> {
+        let root = self.doc.root_element();
+        if root.tag_name().name() != "WindowElement" {
+            return Err(self.error(
+                root,
+                KlemsProblem::NotWindowElement(root.tag_name().name().to_string()),
+            ));
+        }
+        let optical = self.required(root, "Optical")?;
+        let layer = self.required(optical, "Layer")?;
+        let mut header = child(layer, "Material")
+            .map(material_header)
+            .unwrap_or_default();
+        header.file_type = child_text(root, "FileType");
+        header.window_element_type = child_text(root, "WindowElementType");
+
+        let definition = self.required(layer, "DataDefinition")?;
+        let structure_node = self.required(definition, "IncidentDataStructure")?;
+        let structure = structure_node.text().unwrap_or("").trim().to_string();
+        let rows = if structure.eq_ignore_ascii_case("columns") {
+            false
+        } else if structure.eq_ignore_ascii_case("rows") {
+            true
+        } else if structure.to_ascii_lowercase().starts_with("tensortree") {
+            return Err(self.error(structure_node, KlemsProblem::TensorTree(structure)));
+        } else {
+            return Err(self.error(structure_node, KlemsProblem::UnknownStructure(structure)));
+        };
+        let defined = children(definition, "AngleBasis")
+            .map(|node| self.angle_basis(node))
+            .collect::<Result<Vec<_>, _>>()?;
+
+        let mut basis: Option<KlemsBasis> = None;
+        let mut matrices: Vec<KlemsMatrix> = Vec::new();
+        for data in children(layer, "WavelengthData") {
+            let band_node = self.required(data, "Wavelength")?;
+            let band = KlemsBand::parse(band_node.text().unwrap_or(""));
+            for block in children(data, "WavelengthDataBlock") {
+                let direction_node = self.required(block, "WavelengthDataDirection")?;
+                let direction_text = direction_node.text().unwrap_or("").trim();
+                let direction = KlemsDirection::parse(direction_text).ok_or_else(|| {
+                    self.error(
+                        direction_node,
+                        KlemsProblem::UnknownDirection(direction_text.to_string()),
+                    )
+                })?;
+                let what = format!("{band} {direction}");
+                let column_node = self.required(block, "ColumnAngleBasis")?;
+                let row_node = self.required(block, "RowAngleBasis")?;
+                let column = self.resolve_basis(column_node, &defined)?;
+                let row = self.resolve_basis(row_node, &defined)?;
+                if !column.same_geometry(&row) {
+                    return Err(self.error(
+                        row_node,
+                        KlemsProblem::MismatchedBases {
+                            column: column.name,
+                            row: row.name,
+                        },
+                    ));
+                }
+                if let Some(first) = &basis
+                    && !first.same_geometry(&column)
+                {
+                    return Err(self.error(
+                        column_node,
+                        KlemsProblem::MismatchedBases {
+                            column: column.name,
+                            row: first.name.clone(),
+                        },
+                    ));
+                }
+                if matrices
+                    .iter()
+                    .any(|m| m.band == band && m.direction == direction)
+                {
+                    return Err(self.error(direction_node, KlemsProblem::Duplicate(what)));
+                }
+                let data_node = self.required(block, "ScatteringData")?;
+                let matrix = self.matrix(data_node, &what, column.len(), rows)?;
+                basis.get_or_insert(column);
+                matrices.push(KlemsMatrix {
+                    band: band.clone(),
+                    direction,
+                    n: matrix.n,
+                    values: matrix.values,
+                    clipped_negative: matrix.clipped,
+                    line: self.line_of(data_node),
+                });
+            }
+        }
+        let Some(basis) = basis else {
+            return Err(self.error(layer, KlemsProblem::NoData));
+        };
+        Ok(KlemsBsdf {
+            source: self.name.display().to_string(),
+            header,
+            incident_data_structure: if rows { "Rows" } else { "Columns" }.into(),
+            basis,
+            matrices,
+        })
+    }
+
+    /// One `AngleBasis`: its name and, when it has blocks, its rings.
+    fn angle_basis(
+        &self,
+        node: Node<'a, 'input>,
+    ) -> Result<(String, Option<KlemsBasis>), ReadError> {
+        let name = child_text(node, "AngleBasisName").unwrap_or_default();
+        let blocks: Vec<Node> = children(node, "AngleBasisBlock").collect();
+        if blocks.is_empty() {
+            return Ok((name, None));
+        }
+        let mut rings = Vec::with_capacity(blocks.len());
+        for block in blocks {
+            let number =
+                |parent: Node<'a, 'input>, tag: &'static str| -> Result<Option<f64>, ReadError> {
+                    let Some(n) = child(parent, tag) else {
+                        return Ok(None);
+                    };
+                    let text = n.text().unwrap_or("").trim();
+                    match text.parse::<f64>() {
+                        Ok(v) if v.is_finite() => Ok(Some(v)),
+                        _ => Err(self.error(
+                            n,
+                            KlemsProblem::BadValue {
+                                expected: "a finite number",
+                                text: shorten(text),
+                            },
+                        )),
+                    }
+                };
+            let bounds = self.required(block, "ThetaBounds")?;
+            let lower = number(bounds, "LowerTheta")?
+                .ok_or_else(|| self.error(bounds, KlemsProblem::Missing("LowerTheta")))?;
+            let upper = number(bounds, "UpperTheta")?
+                .ok_or_else(|| self.error(bounds, KlemsProblem::Missing("UpperTheta")))?;
+            let n_phis_node = self.required(block, "nPhis")?;
+            let n_phis_text = n_phis_node.text().unwrap_or("").trim();
+            let n_phis = n_phis_text.parse::<usize>().map_err(|_| {
+                self.error(
+                    n_phis_node,
+                    KlemsProblem::BadValue {
+                        expected: "a whole number of patches",
+                        text: shorten(n_phis_text),
+                    },
+                )
+            })?;
+            // The polar cap is centred on the pole, other rings midway.
+            let midpoint = if lower == 0.0 {
+                0.0
+            } else {
+                0.5 * (lower + upper)
+            };
+            let theta = number(block, "Theta")?.unwrap_or(midpoint);
+            rings.push(KlemsRing {
+                theta_deg: theta,
+                lower_theta_deg: lower,
+                upper_theta_deg: upper,
+                n_phis,
+            });
+        }
+        let basis = KlemsBasis::from_rings(&name, rings).map_err(|reason| {
+            self.error(
+                node,
+                KlemsProblem::BadBasis {
+                    name: name.clone(),
+                    reason,
+                },
+            )
+        })?;
+        Ok((name, Some(basis)))
+    }
+
+    /// The basis a `ColumnAngleBasis`/`RowAngleBasis` names: one the file
+    /// defines with blocks, else a built-in one.
+    fn resolve_basis(
+        &self,
+        node: Node<'a, 'input>,
+        defined: &[(String, Option<KlemsBasis>)],
+    ) -> Result<KlemsBasis, ReadError> {
+        let name = node.text().unwrap_or("").trim();
+        let from_file = defined
+            .iter()
+            .find(|(n, b)| b.is_some() && n.trim().eq_ignore_ascii_case(name))
+            .and_then(|(_, b)| b.clone());
+        from_file
+            .or_else(|| KlemsBasis::built_in(name))
+            .ok_or_else(|| self.error(node, KlemsProblem::UnknownBasis(shorten(name))))
+    }
+
+    /// The N × N values of a `ScatteringData` element, stored row-major by
+    /// outgoing patch whatever the file's layout.
+    fn matrix(
+        &self,
+        node: Node<'a, 'input>,
+        what: &str,
+        n: usize,
+        rows: bool,
+    ) -> Result<ParsedMatrix, ReadError> {
+        let expected = n * n;
+        let text = node.text().unwrap_or("");
+        let mut values = Vec::with_capacity(expected);
+        let mut clipped = 0;
+        let mut found = 0;
+        for token in text
+            .split(|c: char| c.is_ascii_whitespace() || c == ',')
+            .filter(|t| !t.is_empty())
+        {
+            found += 1;
+            if found > expected {
+                continue; // count the rest for the message
+            }
+            let value = match token.parse::<f64>() {
+                Ok(v) if v.is_finite() => v,
+                _ => {
+                    return Err(self.error_at_token(
+                        node,
+                        token,
+                        KlemsProblem::NotANumber {
+                            what: what.to_string(),
+                            index: found,
+                            text: shorten(token),
+                        },
+                    ));
+                }
+            };
+            let value = if value >= 0.0 {
+                value
+            } else if value >= NEGATIVE_LIMIT {
+                clipped += 1;
+                0.0
+            } else {
+                let k = found - 1;
+                return Err(self.error_at_token(
+                    node,
+                    token,
+                    KlemsProblem::Negative {
+                        what: what.to_string(),
+                        value,
+                        row: k / n + 1,
+                        column: k % n + 1,
+                    },
+                ));
+            };
+            values.push(value);
+        }
+        if found != expected {
+            return Err(self.error(
+                node,
+                KlemsProblem::TokenCount {
+                    what: what.to_string(),
+                    expected,
+                    n,
+                    found,
+                },
+            ));
+        }
+        if rows {
+            // `Rows`: each text row is one incident patch; transpose to
+            // Radiance's layout, row = outgoing patch.
+            let mut transposed = vec![0.0; expected];
+            for i in 0..n {
+                for o in 0..n {
+                    transposed[o * n + i] = values[i * n + o];
+                }
+            }
+            values = transposed;
+        }
+        Ok(ParsedMatrix { n, values, clipped })
+    }
+
+    /// An error on the line of `token`, a slice of `node`'s text when the
+    /// text is borrowed from the input (no entities); else on the element.
+    fn error_at_token(&self, node: Node<'_, '_>, token: &str, problem: KlemsProblem) -> ReadError {
+        let input = self.doc.input_text();
+        let start = input.as_ptr() as usize;
+        let at = token.as_ptr() as usize;
+        let line = if at >= start && at < start + input.len() {
+            let offset = at - start;
+            input.as_bytes()[..offset]
+                .iter()
+                .filter(|&&b| b == b'\n')
+                .count()
+                + 1
+        } else {
+            self.line_of(node)
+        };
+        parse_error(
+            self.name,
+            line,
+            ParseErrorKind::Klems {
+                element: node.tag_name().name().to_string(),
+                problem,
+            },
+        )
+    }
+}
+
+struct ParsedMatrix {
+    n: usize,
+    values: Vec<f64>,
+    clipped: usize,
+}
+
+fn material_header(material: Node<'_, '_>) -> KlemsHeader {
+    let mut header = KlemsHeader {
+        manufacturer: child_text(material, "Manufacturer"),
+        name: child_text(material, "Name"),
+        thickness: child_text(material, "Thickness"),
+        thickness_unit: child(material, "Thickness")
+            .and_then(|n| n.attribute("unit"))
+            .map(str::to_string),
+        device_type: child_text(material, "DeviceType"),
+        ..KlemsHeader::default()
+    };
+    for c in material.children().filter(Node::is_element) {
+        let tag = c.tag_name().name();
+        if matches!(tag, "Manufacturer" | "Name" | "Thickness" | "DeviceType") {
+            continue;
+        }
+        if let Some(text) = c.text().map(str::trim).filter(|t| !t.is_empty()) {
+            header.other.push((tag.to_string(), text.to_string()));
+        }
+    }
+    header
+}
+
+/// At most 40 characters of `text`, for messages.
+fn shorten(text: &str) -> String {
+    match text.char_indices().nth(40) {
+        Some((cut, _)) => format!("{}...", &text[..cut]),
+        None => text.to_string(),
+    }
+}
