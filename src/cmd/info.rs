@@ -3,6 +3,9 @@
 //! Reads each file with `brtf-gonio` (format from the extension or the
 //! header), summarises it and prints either a readable block per file or,
 //! with `--json`, one JSON array of summaries, each with its `file`.
+//! Klems BSDF XML files (`.xml`, or text starting with `<`) get
+//! `brtf_gonio::klems::KlemsInfo`: header, basis, bands, blocks and ρ_dh /
+//! τ_dh per incidence and side.
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -13,7 +16,7 @@ use serde::Serialize;
 
 #[derive(Args, Debug)]
 pub struct InfoArgs {
-    /// Measurement files (.mpc or pab-opto Mountain).
+    /// Measurement files (.mpc, pab-opto Mountain or Klems BSDF XML).
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
     /// Print machine-readable JSON instead of text.
@@ -23,10 +26,17 @@ pub struct InfoArgs {
 
 /// One entry of the `--json` array.
 #[derive(Serialize)]
-struct FileSummary {
+struct FileSummary<S> {
     file: String,
     #[serde(flatten)]
-    summary: brtf_gonio::Summary,
+    summary: S,
+}
+
+#[derive(Serialize)]
+#[serde(untagged)]
+enum Entry {
+    Measurement(FileSummary<brtf_gonio::Summary>),
+    Klems(FileSummary<brtf_gonio::klems::KlemsInfo>),
 }
 
 pub fn run(args: InfoArgs) -> anyhow::Result<()> {
@@ -40,18 +50,33 @@ pub fn run(args: InfoArgs) -> anyhow::Result<()> {
 fn write_report(args: &InfoArgs, out: &mut impl Write) -> anyhow::Result<()> {
     let mut entries = Vec::with_capacity(args.files.len());
     for (i, path) in args.files.iter().enumerate() {
+        if i > 0 && !args.json {
+            writeln!(out)?;
+        }
+        if brtf_gonio::klems::is_klems_file(path) {
+            let bsdf = brtf_gonio::klems::read_path(path)
+                .with_context(|| format!("reading Klems BSDF {}", path.display()))?;
+            let summary = bsdf.info();
+            if args.json {
+                entries.push(Entry::Klems(FileSummary {
+                    file: path.display().to_string(),
+                    summary,
+                }));
+            } else {
+                writeln!(out, "{}", path.display())?;
+                write!(out, "{summary}")?;
+            }
+            continue;
+        }
         let measurement = brtf_gonio::read_path(path)
             .with_context(|| format!("reading measurement {}", path.display()))?;
         let summary = measurement.summary();
         if args.json {
-            entries.push(FileSummary {
+            entries.push(Entry::Measurement(FileSummary {
                 file: path.display().to_string(),
                 summary,
-            });
+            }));
         } else {
-            if i > 0 {
-                writeln!(out)?;
-            }
             writeln!(out, "{}", path.display())?;
             write!(out, "{summary}")?;
         }

@@ -14,6 +14,7 @@ mod contract;
 mod eval;
 mod export;
 mod fit;
+mod info;
 mod peer;
 mod plot;
 mod render;

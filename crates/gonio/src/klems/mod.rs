@@ -653,3 +653,22 @@ impl fmt::Display for KlemsInfo {
         Ok(())
     }
 }
+
+/// True when `path` looks like a Klems BSDF XML file: an `.xml` extension,
+/// or a first non-blank character `<` (gonio text files never start so).
+/// Unreadable files give `false`; the reader then reports the error.
+pub fn is_klems_file(path: &std::path::Path) -> bool {
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("xml"))
+    {
+        return true;
+    }
+    use std::io::Read;
+    let mut head = [0u8; 512];
+    let Ok(mut file) = std::fs::File::open(path) else {
+        return false;
+    };
+    let n = file.read(&mut head).unwrap_or(0);
+    crate::read::is_xml(&head[..n])
+}
