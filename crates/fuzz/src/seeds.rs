@@ -140,6 +140,19 @@ impl Seeds {
                 });
             }
         }
+        // Klems BSDF XML for the detecting reader (which hands it to the
+        // Klems reader, as `brtf info` does): the real Mecho fabric moved to
+        // the Quarter basis (each Quarter patch takes the value of the Full
+        // patch holding its centre), 41 x 41 per block, so one case costs
+        // well under a millisecond; the whole files are too slow for CI.
+        let mecho = data.join("lbnl-frads-klems-fabrics/klems_aniso_high.xml");
+        seeds.all.push(Seed {
+            target: Target::DetectedGonio,
+            name: "klems_quarter.xml".into(),
+            origin: "klems_aniso_high.xml on the Klems Quarter basis".into(),
+            bytes: klems_quarter(&mecho)?.into_bytes(),
+            whole_big_file: false,
+        });
         for path in rad_files(repo) {
             let Ok(bytes) = std::fs::read(&path) else {
                 continue; // vanished since the walk
@@ -309,4 +322,46 @@ fn collect_rad_files(dir: &Path, out: &mut Vec<PathBuf>) {
             out.push(path);
         }
     }
+}
+
+/// The Klems file at `path` resampled to the Quarter basis, as XML text.
+fn klems_quarter(path: &Path) -> Result<String, String> {
+    use brtf_gonio::klems::{self, KlemsBasis};
+    let full = klems::read_path(path).map_err(|e| format!("seed {}: {e}", path.display()))?;
+    let quarter = KlemsBasis::built_in("LBNL/Klems Quarter").expect("built in");
+    let nearest: Vec<usize> = quarter
+        .patches()
+        .iter()
+        .map(|p| full.basis.patch_index(p.theta_deg, p.phi_deg).unwrap_or(0))
+        .collect();
+    let mut text = String::from(
+        "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n\
+         <WindowElement xmlns=\"http://windows.lbl.gov\">\n<FileType>BSDF</FileType>\n\
+         <Optical>\n<Layer>\n<Material>\n<Name>fuzz seed</Name>\n\
+         <Thickness unit=\"Millimeter\">1</Thickness>\n</Material>\n<DataDefinition>\n\
+         <IncidentDataStructure>Columns</IncidentDataStructure>\n<AngleBasis>\n\
+         <AngleBasisName>LBNL/Klems Quarter</AngleBasisName>\n</AngleBasis>\n\
+         </DataDefinition>\n",
+    );
+    for m in &full.matrices {
+        text += &format!(
+            "<WavelengthData>\n<Wavelength unit=\"Integral\">{}</Wavelength>\n\
+             <WavelengthDataBlock>\n<WavelengthDataDirection>{}</WavelengthDataDirection>\n\
+             <ColumnAngleBasis>LBNL/Klems Quarter</ColumnAngleBasis>\n\
+             <RowAngleBasis>LBNL/Klems Quarter</RowAngleBasis>\n\
+             <ScatteringDataType>BTDF</ScatteringDataType>\n<ScatteringData>\n",
+            m.band, m.direction
+        );
+        for &o in &nearest {
+            let row: Vec<String> = nearest
+                .iter()
+                .map(|&i| format!("{:.5}", m.value(o, i)))
+                .collect();
+            text += &row.join(", ");
+            text += "\n";
+        }
+        text += "</ScatteringData>\n</WavelengthDataBlock>\n</WavelengthData>\n";
+    }
+    text += "</Layer>\n</Optical>\n</WindowElement>\n";
+    Ok(text)
 }

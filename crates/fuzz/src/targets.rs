@@ -50,6 +50,12 @@ pub fn exercise(target: Target, name: &str, bytes: &[u8]) -> Outcome {
 }
 
 fn gonio(bytes: &[u8], name: &str, format: Option<SourceFormat>) -> Outcome {
+    // Detected Klems XML goes where `brtf info` sends it.
+    if format.is_none()
+        && brtf_gonio::detect_format(bytes, Path::new(name)) == SourceFormat::KlemsXml
+    {
+        return klems(bytes, name);
+    }
     let result = match format {
         Some(format) => brtf_gonio::read_bytes_as(bytes, name, format),
         None => brtf_gonio::read_bytes(bytes, name),
@@ -71,6 +77,42 @@ fn gonio(bytes: &[u8], name: &str, format: Option<SourceFormat>) -> Outcome {
     let _ = measurement.summary();
     if let Some((class, detail)) = round_trip(&measurement, name) {
         return anomaly(class, detail);
+    }
+    Outcome::Accepted
+}
+
+/// The Klems reader, then what `brtf info` and the conversion to
+/// measurements do with an accepted file.
+fn klems(bytes: &[u8], name: &str) -> Outcome {
+    let bsdf = match brtf_gonio::klems::read_bytes(bytes, name) {
+        Ok(b) => b,
+        Err(e) => {
+            let message = e.to_string();
+            let lines = line_count(bytes, false);
+            return match e.line() {
+                Some(line) if line == 0 || line > lines => anomaly(
+                    "error line outside the file",
+                    format!("error on line {line} of a {lines}-line file: {message}"),
+                ),
+                _ => located(message, name),
+            };
+        }
+    };
+    let info = bsdf.info();
+    let _ = info.to_string();
+    let not_finite = |v: Option<f64>| v.is_some_and(|v| !v.is_finite());
+    if let Some(p) = info
+        .incidences
+        .iter()
+        .find(|p| not_finite(p.rho_dh) || not_finite(p.tau_dh))
+    {
+        return anomaly(
+            "accepted Klems file has a non-finite column total",
+            format!("{p:?}"),
+        );
+    }
+    for m in bsdf.to_measurements() {
+        let _ = m.summary();
     }
     Outcome::Accepted
 }
