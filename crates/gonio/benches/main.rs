@@ -1,6 +1,7 @@
 //! brtf-gonio benchmarks: parse throughput, solid angles and the summary on
-//! the real 4 MB pgII scan `golden_paper.txt` (read from `../shared/data`,
-//! never copied into the repository).
+//! the real 4 MB pgII scan `golden_paper.txt`, and reading the two real
+//! Klems Full files (all read from `../shared/data`, never copied into the
+//! repository).
 
 use std::hint::black_box;
 use std::path::{Path, PathBuf};
@@ -61,5 +62,35 @@ fn geometry(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, parse, write, geometry);
+/// Reading the real Klems Full files (bytes already in memory: XML parse,
+/// basis, 145 x 145 matrices). pyradiance's own loader is not a peer here:
+/// `pyradiance.bsdf.load_file` hung on the second load in one process
+/// (and `free` double-frees), so it cannot be timed in a loop.
+fn klems(c: &mut Criterion) {
+    let folder =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/lbnl-frads-klems-fabrics");
+    let mut group = c.benchmark_group("klems");
+    for name in ["klems_aniso_high.xml", "2011-SA1.xml"] {
+        let path = folder.join(name);
+        assert!(
+            path.is_file(),
+            "{} is missing: the benchmark needs the shared data folder beside the repository",
+            path.display()
+        );
+        let bytes = std::fs::read(&path).unwrap();
+        group.throughput(Throughput::Bytes(bytes.len() as u64));
+        group.bench_function(format!("read_{name}"), |b| {
+            b.iter(|| brtf_gonio::klems::read_bytes(black_box(&bytes), &path).unwrap())
+        });
+    }
+    group.finish();
+    let mecho = brtf_gonio::klems::read_path(&folder.join("klems_aniso_high.xml")).unwrap();
+    let mut group = c.benchmark_group("klems_convert");
+    group.bench_function("to_measurements_klems_aniso_high", |b| {
+        b.iter(|| black_box(&mecho).to_measurements())
+    });
+    group.finish();
+}
+
+criterion_group!(benches, parse, write, geometry, klems);
 criterion_main!(benches);

@@ -297,15 +297,13 @@ impl<'a, 'input> Reader<'a, 'input> {
         let mut values = Vec::with_capacity(expected);
         let mut clipped = 0;
         let mut found = 0;
-        for token in text
-            .split(|c: char| c.is_ascii_whitespace() || c == ',')
-            .filter(|t| !t.is_empty())
-        {
+        for token in tokens(text) {
             found += 1;
             if found > expected {
                 continue; // count the rest for the message
             }
-            let value = match token.parse::<f64>() {
+            // The gonio readers' exact fast path (same bits as str::parse).
+            let value = match crate::read::number::parse_f64(token) {
                 Ok(v) if v.is_finite() => v,
                 _ => {
                     return Err(self.error_at_token(
@@ -389,6 +387,27 @@ impl<'a, 'input> Reader<'a, 'input> {
             },
         )
     }
+}
+
+/// The values of a matrix text: runs of bytes between white space and
+/// commas (both ASCII, so every slice is on a character boundary).
+fn tokens(text: &str) -> impl Iterator<Item = &str> {
+    let bytes = text.as_bytes();
+    let is_separator = |b: u8| b.is_ascii_whitespace() || b == b',';
+    let mut pos = 0;
+    std::iter::from_fn(move || {
+        while pos < bytes.len() && is_separator(bytes[pos]) {
+            pos += 1;
+        }
+        if pos >= bytes.len() {
+            return None;
+        }
+        let start = pos;
+        while pos < bytes.len() && !is_separator(bytes[pos]) {
+            pos += 1;
+        }
+        Some(&text[start..pos])
+    })
 }
 
 struct ParsedMatrix {

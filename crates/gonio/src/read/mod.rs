@@ -14,7 +14,7 @@
 
 pub(crate) mod mountain;
 pub(crate) mod mpc;
-mod number;
+pub(crate) mod number;
 mod text;
 
 use std::borrow::Cow;
