@@ -64,8 +64,9 @@ fn geometry(c: &mut Criterion) {
 
 /// Reading the real Klems Full files (bytes already in memory: XML parse,
 /// basis, 145 x 145 matrices). pyradiance's own loader is not a peer here:
-/// `pyradiance.bsdf.load_file` hung on the second load in one process
-/// (and `free` double-frees), so it cannot be timed in a loop.
+/// a loop of `pyradiance.bsdf.load_file` in one Python process did not
+/// finish (and `pyradiance.bsdf.free` aborts with a double free), so it
+/// cannot be timed properly.
 fn klems(c: &mut Criterion) {
     let folder =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/lbnl-frads-klems-fabrics");

@@ -430,7 +430,7 @@ fn klems_error(text: &str, name: &str) -> (String, usize, KlemsProblem) {
 fn wrong_token_count_names_the_file_and_element() {
     let mut values = ramp();
     values.pop();
-    let (message, _, problem) = klems_error(
+    let (message, line, problem) = klems_error(
         &quarter_file(
             "Columns",
             "<AngleBasisName>LBNL/Klems Quarter</AngleBasisName>",
@@ -438,6 +438,7 @@ fn wrong_token_count_names_the_file_and_element() {
         ),
         "short.xml",
     );
+    assert_eq!(line, 16, "{message}");
     assert!(matches!(
         problem,
         KlemsProblem::TokenCount {
