@@ -388,6 +388,12 @@ fn rows_is_the_transpose_and_bases_may_be_named_or_explicit() {
         );
         assert_eq!(explicit.matrices[0].values, c.values);
     }
+    // CRLF line ends read the same.
+    let crlf = quarter_file("Columns", named, &ramp()).replace('\n', "\r\n");
+    assert_eq!(
+        klems::read_str(&crlf, "crlf.xml").unwrap().matrices[0].values,
+        c.values
+    );
     // Values just below 0 read as 0 (and are counted), as Radiance does.
     let mut values = ramp();
     values[7] = -5e-4;

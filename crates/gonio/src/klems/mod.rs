@@ -289,6 +289,8 @@ pub struct KlemsMatrix {
 
 impl KlemsMatrix {
     /// BSDF from incident patch `incident` to outgoing patch `outgoing`.
+    /// Panics when either index is not below `n` (a caller's bug; the
+    /// file's content cannot cause it).
     pub fn value(&self, outgoing: usize, incident: usize) -> f64 {
         self.values[outgoing * self.n + incident]
     }
