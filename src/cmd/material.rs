@@ -28,6 +28,18 @@ pub struct MaterialArgs {
     pub curved: bool,
 }
 
+/// The formula options of a material given by its arguments (`brtf fit`,
+/// `brtf synth --material`).
+#[derive(Args, Debug, Clone, Copy)]
+pub struct FormulaArgs {
+    /// Formula set: radiance (current rtrace), manual2004 or ward1992.
+    #[arg(long, default_value = "radiance", value_parser = parse_variant)]
+    pub variant: Variant,
+    /// Fresnel constant for roughness-0 surfaces: classic, pyradiance or a number.
+    #[arg(long, default_value = "classic", value_parser = parse_fresnel_k)]
+    pub fresnel_k: f64,
+}
+
 /// Clap parser for `--variant`.
 pub(crate) fn parse_variant(s: &str) -> Result<Variant, String> {
     s.parse()

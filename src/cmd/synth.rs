@@ -1,11 +1,10 @@
 //! `brtf synth`: synthetic measurement files with instrument effects.
 
-use super::material::{MaterialArgs, parse_fresnel_k, parse_variant};
+use super::material::{FormulaArgs, MaterialArgs};
 use super::output::write_atomic;
 use anyhow::{Result, bail};
 use brtf_gonio::synth::{GroundTruth, Instrument, Layout, SYNTH_MARKER, SynthSet};
 use brtf_gonio::{Channels, SourceFormat};
-use brtf_model::Variant;
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 
@@ -84,12 +83,8 @@ pub struct SynthModelArgs {
     /// Which material in the file.
     #[arg(long)]
     pub name: Option<String>,
-    /// Formula set of the material.
-    #[arg(long, default_value = "radiance", value_parser = parse_variant)]
-    pub variant: Variant,
-    /// Fresnel constant: classic, pyradiance or a number.
-    #[arg(long, default_value = "classic", value_parser = parse_fresnel_k)]
-    pub fresnel_k: f64,
+    #[command(flatten)]
+    pub formula: FormulaArgs,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -104,8 +99,8 @@ pub fn run(args: SynthArgs) -> Result<()> {
             let material = MaterialArgs {
                 material: path.clone(),
                 name: args.model.name.clone(),
-                variant: args.model.variant,
-                fresnel_k: args.model.fresnel_k,
+                variant: args.model.formula.variant,
+                fresnel_k: args.model.formula.fresnel_k,
                 source_omega: 0.0,
                 curved: false,
             };

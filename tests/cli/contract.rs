@@ -24,6 +24,35 @@ fn shipped_files() -> Vec<String> {
     files
 }
 
+/// Noise-free `brtf synth` files of the material `text` at θ_in 0, 30 and
+/// 60°, with `extra` options, into `dir/set`; their paths, sorted.
+fn synth_set(dir: &Path, text: &str, extra: &[&str]) -> Vec<String> {
+    let rad = dir.join("truth.rad");
+    std::fs::write(&rad, text).unwrap();
+    let set = dir.join("set");
+    let mut args = vec![
+        "synth",
+        "--material",
+        s(&rad),
+        "--theta-in",
+        "0,30,60",
+        "--out",
+        s(&set),
+        "--noise",
+        "0",
+        "--noise-floor",
+        "0",
+    ];
+    args.extend_from_slice(extra);
+    brtf(&args, "").ok();
+    let mut files: Vec<String> = std::fs::read_dir(&set)
+        .unwrap()
+        .map(|e| s(&e.unwrap().path()).to_string())
+        .collect();
+    files.sort();
+    files
+}
+
 fn fit_into(out: &Path, files: &[String], extra: &[&str]) -> FitResult {
     let mut args: Vec<String> = vec!["fit".into()];
     args.extend(files.iter().cloned());
@@ -190,31 +219,12 @@ fn other_schema_versions_are_refused_by_every_reader() {
 #[test]
 fn a_parameter_at_a_bound_breaks_no_command() {
     let dir = temp_dir();
-    let rad = dir.path().join("white.rad");
-    std::fs::write(&rad, "void plastic white 0 0 5 0.6 0.6 0.6 0 0\n").unwrap();
-    let set = dir.path().join("set");
-    brtf(
-        &[
-            "synth",
-            "--material",
-            s(&rad),
-            "--theta-in",
-            "0,30,60",
-            "--out",
-            s(&set),
-            "--noise",
-            "0",
-            "--noise-floor",
-            "0",
-        ],
-        "",
-    )
-    .ok();
-    let mut files: Vec<String> = std::fs::read_dir(&set)
-        .unwrap()
-        .map(|e| s(&e.unwrap().path()).to_string())
-        .collect();
-    files.sort();
+    let files = synth_set(
+        dir.path(),
+        "void plastic white 0 0 5 0.6 0.6 0.6 0 0
+",
+        &[],
+    );
     let out = dir.path().join("fit");
     let result = fit_into(&out, &files, &["--model", "metal", "--gray"]);
     let bounded: Vec<_> = result
@@ -268,39 +278,11 @@ fn a_parameter_at_a_bound_breaks_no_command() {
 #[test]
 fn xyz_data_are_fitted_and_exported_in_radiance_rgb() {
     let dir = temp_dir();
-    let rad = dir.path().join("green.rad");
-    std::fs::write(
-        &rad,
+    let files = synth_set(
+        dir.path(),
         "void plastic green 0 0 5 0.100 0.401 0.121 0.04 0.1\n",
-    )
-    .unwrap();
-    let set = dir.path().join("set");
-    brtf(
-        &[
-            "synth",
-            "--material",
-            s(&rad),
-            "--theta-in",
-            "0,30,60",
-            "--out",
-            s(&set),
-            "--format",
-            "mountain",
-            "--channels",
-            "3",
-            "--noise",
-            "0",
-            "--noise-floor",
-            "0",
-        ],
-        "",
-    )
-    .ok();
-    let mut files: Vec<String> = std::fs::read_dir(&set)
-        .unwrap()
-        .map(|e| s(&e.unwrap().path()).to_string())
-        .collect();
-    files.sort();
+        &["--format", "mountain", "--channels", "3"],
+    );
     // The files hold true XYZ: at normal incidence, every sample is the
     // XYZ of the material's RGB BSDF.
     let m = brtf_gonio::read_path(Path::new(&files[0])).unwrap();

@@ -1,13 +1,13 @@
 //! The arguments of `brtf fit` and the library options they mean.
 
-use crate::cmd::material::{parse_fresnel_k, parse_variant};
+use crate::cmd::material::FormulaArgs;
 use anyhow::{Result, bail};
 use brtf_fit::{
     ColourConversion, FitConfig, FitSetOptions, Gate, Interpolation, KnownReflectance, Recipe,
     ResidualKind, RobustLoss, ScaleRule, WeightRule,
 };
 use brtf_gonio::Hemisphere;
-use brtf_model::{MaterialKind, Variant};
+use brtf_model::MaterialKind;
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 
@@ -31,12 +31,8 @@ pub struct FitArgs {
     /// Material name [default: the files' #sample_name, else their common file-name stem].
     #[arg(long)]
     pub name: Option<String>,
-    /// Formula set: radiance (current rtrace), manual2004 or ward1992.
-    #[arg(long, default_value = "radiance", value_parser = parse_variant)]
-    pub variant: Variant,
-    /// Fresnel constant for roughness-0 surfaces: classic, pyradiance or a number.
-    #[arg(long, default_value = "classic", value_parser = parse_fresnel_k)]
-    pub fresnel_k: f64,
+    #[command(flatten)]
+    pub formula: FormulaArgs,
     /// Solid angle of the instrument's source in sr, modelled as rtrace's widening.
     #[arg(long, default_value_t = 0.0)]
     pub source_omega: f64,
@@ -175,8 +171,8 @@ impl FitArgs {
             selections.push(brtf_gonio::PGII_HOLDER_BAND);
         }
         let mut config = FitConfig::new(self.model);
-        config.options.variant = self.variant;
-        config.options.fresnel_k = self.fresnel_k;
+        config.options.variant = self.formula.variant;
+        config.options.fresnel_k = self.formula.fresnel_k;
         config.options.source_omega = self.source_omega;
         config.orientation = [x, y, z];
         config.gray = self.gray;
