@@ -10,6 +10,8 @@
 
 use std::f64::consts::PI;
 
+use brtf_model::rng::Rng;
+use glam::DVec3;
 use serde::Serialize;
 
 /// One θ ring of a basis.
@@ -58,6 +60,51 @@ impl KlemsPatch {
             // solid angle is the sensible weight there.
             self.solid_angle_sr
         }
+    }
+
+    /// `n` directions spread over the patch uniformly in projected solid
+    /// angle, as unit vectors on the +z hemisphere
+    /// (sin θ cos φ, sin θ sin φ, cos θ).
+    ///
+    /// The patch is cut into an `a × b` grid of equal strata in
+    /// (cos² θ, φ), with `a · b = n` and `a` the largest divisor of `n` not
+    /// above √n (16 → 4 × 4, 32 → 4 × 8), and one point is drawn in each
+    /// stratum from `rng`. Equal cells in cos² θ carry equal Λ, so the
+    /// plain mean of f over the points estimates the patch average
+    /// (1/Λ) ∫ f cos θ dω that Klems values are. The same `rng` state
+    /// gives the same points: averages are deterministic.
+    pub fn stratified_directions(&self, n: usize, rng: &mut Rng) -> Vec<DVec3> {
+        let n = n.max(1);
+        let rows = (1..=n)
+            .take_while(|a| a * a <= n)
+            .filter(|a| n % a == 0)
+            .last()
+            .unwrap_or(1);
+        let columns = n / rows;
+        let (lo, hi) = self.theta_bounds_deg;
+        // cos² θ runs from its value at the lower bound (larger) down to
+        // the upper bound.
+        let c2_top = lo.to_radians().cos().powi(2);
+        let c2_bottom = hi.to_radians().cos().powi(2);
+        let (phi_lo, phi_hi) = self.phi_bounds_deg;
+        let mut out = Vec::with_capacity(n);
+        for r in 0..rows {
+            for c in 0..columns {
+                let [ju, jv] = rng.uniform2();
+                let t = (r as f64 + ju) / rows as f64;
+                let cos2 = c2_top + (c2_bottom - c2_top) * t;
+                let cos_theta = cos2.max(0.0).sqrt();
+                let sin_theta = (1.0 - cos2).max(0.0).sqrt();
+                let phi =
+                    (phi_lo + (phi_hi - phi_lo) * (c as f64 + jv) / columns as f64).to_radians();
+                out.push(DVec3::new(
+                    sin_theta * phi.cos(),
+                    sin_theta * phi.sin(),
+                    cos_theta,
+                ));
+            }
+        }
+        out
     }
 }
 
@@ -308,5 +355,37 @@ mod tests {
         assert_eq!(basis.patch_index(10.0, 22.6), Some(2));
         assert_eq!(basis.patch_index(90.0, 0.0), Some(133));
         assert_eq!(basis.patch_index(90.5, 0.0), None);
+    }
+
+    #[test]
+    fn stratified_directions_stay_in_their_patch_and_average_cos_theta() {
+        let basis = KlemsBasis::full();
+        let mut rng = Rng::new(7, 0);
+        for (i, p) in basis.patches().iter().enumerate() {
+            let points = p.stratified_directions(64, &mut rng);
+            assert_eq!(points.len(), 64);
+            for v in &points {
+                assert!((v.length() - 1.0).abs() < 1e-12);
+                let theta = v.z.clamp(-1.0, 1.0).acos().to_degrees();
+                let phi = v.y.atan2(v.x).to_degrees();
+                assert_eq!(basis.patch_index(theta, phi), Some(i), "{theta} {phi}");
+            }
+            // Uniform in projected solid angle: the mean of 1/cos θ over
+            // the points estimates Ω/Λ.
+            let mean: f64 = points.iter().map(|v| 1.0 / v.z).sum::<f64>() / 64.0;
+            let exact = p.solid_angle_sr / p.projected_solid_angle_sr;
+            if p.theta_bounds_deg.1 < 80.0 {
+                assert!(
+                    (mean / exact - 1.0).abs() < 0.01,
+                    "patch {i}: {mean} vs {exact}"
+                );
+            }
+        }
+        // Deterministic for a given seed.
+        let p = basis.patch(40).unwrap();
+        assert_eq!(
+            p.stratified_directions(16, &mut Rng::new(3, 1)),
+            p.stratified_directions(16, &mut Rng::new(3, 1))
+        );
     }
 }
