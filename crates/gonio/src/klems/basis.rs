@@ -77,7 +77,7 @@ impl KlemsPatch {
         let n = n.max(1);
         let rows = (1..=n)
             .take_while(|a| a * a <= n)
-            .filter(|a| n % a == 0)
+            .filter(|a| n.is_multiple_of(*a))
             .last()
             .unwrap_or(1);
         let columns = n / rows;
