@@ -19,7 +19,9 @@
 //! reflection or the transmission side.
 
 pub mod basis;
+pub mod model_matrix;
 mod read;
+pub mod write;
 
 use std::fmt;
 
@@ -31,6 +33,7 @@ use crate::measurement::{
 
 pub use basis::{KlemsBasis, KlemsPatch, KlemsRing};
 pub use read::{read_bytes, read_path, read_str};
+pub use write::{KlemsWriteBlock, KlemsWriteHeader, to_klems_xml};
 
 /// Values below this are refused; values between it and 0 read as 0.
 pub const NEGATIVE_LIMIT: f64 = -1e-3;
