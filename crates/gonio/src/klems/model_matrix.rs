@@ -3,11 +3,12 @@
 //!
 //! Entry (o, i) is the BSDF averaged over outgoing patch o (weighted by
 //! projected solid angle, as a Klems value is defined) **and** over
-//! incident patch i (as `bsdf2klems` does): the mean over k of
-//! f(l_k, v_k), where v_k are [`KlemsPatch::stratified_directions`] of
-//! patch o and l_k those of patch i, paired through a cyclic shift drawn
-//! per entry. Both point sets are uniform in projected solid angle, so
-//! the plain mean is the double patch average. Roughness-0 (delta)
+//! incident patch i (as `bsdf2klems` does): the mean of f(l, v) over
+//! every pair of a light point l of patch i and a view point v of patch
+//! o, each set from [`KlemsPatch::stratified_directions`](super::KlemsPatch::stratified_directions)
+//! ([`split_samples`] splits the sample count between them). Both sets
+//! are uniform in projected solid angle, so the plain mean is the double
+//! patch average. Roughness-0 (delta)
 //! mirror and straight-through parts add E/Λ_i to the diagonal, E averaged
 //! over the incident patch.
 //!
@@ -103,23 +104,28 @@ pub fn side_matrices(
     let n = basis.len();
     assert_eq!(bsdf_of_patch.len(), n, "one BSDF per incident patch");
     let samples = options.samples.max(1);
+    let (n_light, n_view) = split_samples(samples);
     let patches = basis.patches();
-    // One stratified point set per patch for the outgoing side and one
-    // (other stream) for the incident side; entries pair them through a
-    // cyclic shift drawn per entry, which keeps each entry unbiased.
-    let points = |stream_base: u64| -> Vec<Vec<DVec3>> {
+    // Per patch one stratified point set for the outgoing side and one
+    // (other streams) for the incident side. An entry averages f over
+    // every pair: n_light incident points × n_view outgoing points. For
+    // each incident point the outgoing sets of all patches together
+    // integrate the whole hemisphere, so column totals (ρ_dh, τ_dh) are
+    // good even where single entries are noisy.
+    let points = |stream_base: u64, count: usize| -> Vec<Vec<DVec3>> {
         patches
             .iter()
             .enumerate()
             .map(|(k, p)| {
                 let mut rng = Rng::new(options.seed, stream_base + k as u64);
-                p.stratified_directions(samples, &mut rng)
+                p.stratified_directions(count, &mut rng)
             })
             .collect()
     };
-    let outgoing = points(0);
-    let incident = points(1 << 32);
+    let outgoing = points(0, n_view);
+    let incident = points(1 << 32, n_light);
     let lambda = basis.projected_solid_angles();
+    let weight = 1.0 / (n_light * n_view) as f64;
 
     // Column by column (incident patch), in parallel.
     let columns: Vec<(Vec<Rgb>, Vec<Rgb>)> = (0..n)
@@ -130,23 +136,24 @@ pub fn side_matrices(
                 .iter()
                 .map(|&p| light_vector(Side::Front, p))
                 .collect();
-            let mut shift_rng = Rng::new(options.seed, (2 << 32) + i as u64);
             let mut reflection = vec![[0.0; 3]; n];
             let mut through = vec![[0.0; 3]; if transmission { n } else { 0 }];
             for o in 0..n {
-                let shift = (shift_rng.next_u64() % samples as u64) as usize;
                 let mut sum_r = [0.0; 3];
                 let mut sum_t = [0.0; 3];
-                for (k, &p) in outgoing[o].iter().enumerate() {
-                    let l = lights[(k + shift) % samples];
-                    add(&mut sum_r, bsdf.eval(l, view_vector(Side::Front, false, p)));
-                    if transmission {
-                        add(&mut sum_t, bsdf.eval(l, view_vector(Side::Front, true, p)));
+                for &p in &outgoing[o] {
+                    let v_r = view_vector(Side::Front, false, p);
+                    let v_t = view_vector(Side::Front, true, p);
+                    for &l in &lights {
+                        add(&mut sum_r, bsdf.eval(l, v_r));
+                        if transmission {
+                            add(&mut sum_t, bsdf.eval(l, v_t));
+                        }
                     }
                 }
-                reflection[o] = sum_r.map(|s| s / samples as f64);
+                reflection[o] = sum_r.map(|s| s * weight);
                 if transmission {
-                    through[o] = sum_t.map(|s| s / samples as f64);
+                    through[o] = sum_t.map(|s| s * weight);
                 }
             }
             // Delta parts: E averaged over the incident patch, spread
@@ -159,7 +166,7 @@ pub fn side_matrices(
                     add(&mut mirror, m);
                     add(&mut straight, t);
                 }
-                let scale = 1.0 / (samples as f64 * lambda[i]);
+                let scale = 1.0 / (n_light as f64 * lambda[i]);
                 add(&mut reflection[i], mirror.map(|e| e * scale));
                 if transmission {
                     add(&mut through[i], straight.map(|e| e * scale));
@@ -184,6 +191,19 @@ pub fn side_matrices(
         reflection,
         transmission: transmission.then_some(through),
     }
+}
+
+/// `samples` as incident points × outgoing points per entry: the
+/// largest divisor not above √samples incident points (256 → 16 × 16,
+/// 512 → 16 × 32).
+pub fn split_samples(samples: usize) -> (usize, usize) {
+    let samples = samples.max(1);
+    let n_light = (1..=samples)
+        .take_while(|a| a * a <= samples)
+        .filter(|a| samples.is_multiple_of(*a))
+        .last()
+        .unwrap_or(1);
+    (n_light, samples / n_light)
 }
 
 fn add(sum: &mut Rgb, value: Rgb) {

@@ -13,6 +13,7 @@
 //! renamed into place). `docs/radiance.md` explains how to use the files.
 
 mod cal;
+pub mod klems;
 mod num;
 mod pieces;
 mod preview;
