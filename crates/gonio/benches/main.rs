@@ -52,6 +52,20 @@ fn geometry(c: &mut Criterion) {
     group.bench_function("solid_angles_golden_paper_127k", |b| {
         b.iter(|| brtf_gonio::compute_solid_angles(black_box(&m.samples)))
     });
+    // A ring layout of the same size (212 rings x 600 azimuths to 85°):
+    // the ring path.
+    let rings: Vec<brtf_gonio::Sample> = (0..212)
+        .flat_map(|i| {
+            let theta = 85.0 * (i as f64 + 0.5) / 212.0;
+            (0..600).map(move |j| brtf_gonio::Sample::luminance(theta, 0.6 * j as f64, 1.0))
+        })
+        .collect();
+    group.bench_function("solid_angles_rings_127k", |b| {
+        b.iter(|| brtf_gonio::compute_solid_angles(black_box(&rings)))
+    });
+    group.bench_function("solid_angles_rings_127k_voronoi", |b| {
+        b.iter(|| brtf_gonio::solid_angle::voronoi_solid_angles(black_box(&rings)))
+    });
     group.bench_function("summary_golden_paper_127k", |b| {
         b.iter(|| black_box(&m).summary())
     });

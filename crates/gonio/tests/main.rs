@@ -15,6 +15,7 @@ mod read;
 mod robustness;
 mod select;
 mod solid_angle;
+mod solid_angle_paths;
 mod summary;
 mod synth;
 mod write;

@@ -1,9 +1,4 @@
-//! Per-sample solid angles (quadrature weights) from the sample directions.
-//!
-//! This module owns the answer to "how much of the sphere does each sample
-//! stand for?". [`solid_angles`] uses the file's Voronoi cell sizes when
-//! every sample has a valid one and otherwise calls
-//! [`compute_solid_angles`], which works on the directions alone:
+//! The general path: equal-area Voronoi cells, for scattered layouts.
 //!
 //! 1. Each hemisphere is handled on its own. Its directions are mapped to
 //!    the plane with the Lambert azimuthal equal-area projection about the
@@ -25,37 +20,15 @@
 //! projected plane: not the spherical Voronoi cells, but an exact
 //! partition, so a constant integrates exactly and smooth functions to
 //! quadrature accuracy. Coincident directions (after rounding the projected
-//! coordinates to 2⁻³⁰) share one cell equally; non-finite directions get
-//! weight 0. The result is deterministic and independent of the sample
-//! order: points are sorted by their projected coordinates before the
-//! triangulation.
+//! coordinates to 2⁻³⁰) share one cell equally. The result is
+//! deterministic and independent of the sample order: points are sorted by
+//! their projected coordinates before the triangulation.
 
 use std::collections::HashMap;
 
 use delaunator::{EMPTY, Point, next_halfedge, triangulate};
-use serde::{Deserialize, Serialize};
 
-use crate::measurement::{Hemisphere, Measurement, Sample};
-
-/// Where a set of solid angles came from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum SolidAngleSource {
-    /// The file's Voronoi cell sizes (`.mpc` column 8, or
-    /// [`Sample::solid_angle_sr`] set by code).
-    File,
-    /// Computed from the sample directions by [`compute_solid_angles`].
-    Computed,
-}
-
-/// Per-sample solid angles, parallel to [`Measurement::samples`].
-#[derive(Clone, Debug, PartialEq)]
-pub struct SolidAngles {
-    /// Solid angle of each sample, sr.
-    pub per_sample_sr: Vec<f64>,
-    /// Where they came from.
-    pub source: SolidAngleSource,
-}
+use crate::measurement::Hemisphere;
 
 /// Radius of the equal-area disk that one hemisphere maps to (√2).
 pub const DISK_RADIUS: f64 = std::f64::consts::SQRT_2;
@@ -67,60 +40,14 @@ const GRID: f64 = 1.0 / (1u64 << 30) as f64;
 /// Number of ghost points closing the outer Voronoi cells.
 const GHOSTS: usize = 32;
 
-/// The solid angles to use for `measurement`: the file's when every sample
-/// has a finite, non-negative one, computed ones otherwise.
-pub fn solid_angles(measurement: &Measurement) -> SolidAngles {
-    let from_file: Option<Vec<f64>> = measurement
-        .samples
+/// Equal-area Voronoi cell areas (sr) of the directions `(θ, φ)` in degrees,
+/// all valid and in `hemisphere`.
+pub(crate) fn hemisphere_areas(directions: &[(f64, f64)], hemisphere: Hemisphere) -> Vec<f64> {
+    let points: Vec<[f64; 2]> = directions
         .iter()
-        .map(|s| s.solid_angle_sr.filter(|w| w.is_finite() && *w >= 0.0))
+        .map(|&(theta, phi)| project(theta, phi, hemisphere))
         .collect();
-    match from_file {
-        Some(per_sample_sr) if !per_sample_sr.is_empty() => SolidAngles {
-            per_sample_sr,
-            source: SolidAngleSource::File,
-        },
-        _ => SolidAngles {
-            per_sample_sr: compute_solid_angles(&measurement.samples),
-            source: SolidAngleSource::Computed,
-        },
-    }
-}
-
-impl Measurement {
-    /// Sets every sample's [`Sample::solid_angle_sr`] from
-    /// [`solid_angles`], so the weights survive later selections.
-    pub fn fill_solid_angles(&mut self) -> SolidAngleSource {
-        let weights = solid_angles(self);
-        for (sample, w) in self.samples.iter_mut().zip(&weights.per_sample_sr) {
-            sample.solid_angle_sr = Some(*w);
-        }
-        weights.source
-    }
-}
-
-/// Solid angles (sr) computed from the sample directions alone; see the
-/// module docs. Each hemisphere's weights sum to 2π when it has samples.
-pub fn compute_solid_angles(samples: &[Sample]) -> Vec<f64> {
-    let mut weights = vec![0.0; samples.len()];
-    for hemisphere in [Hemisphere::Front, Hemisphere::Back] {
-        let mut indices = Vec::new();
-        let mut points = Vec::new();
-        for (i, s) in samples.iter().enumerate() {
-            let valid = s.theta_deg.is_finite()
-                && (0.0..=180.0).contains(&s.theta_deg)
-                && s.phi_deg.is_finite();
-            if valid && s.hemisphere() == hemisphere {
-                indices.push(i);
-                points.push(project(s.theta_deg, s.phi_deg, hemisphere));
-            }
-        }
-        let areas = disk_voronoi_areas(&points);
-        for (i, area) in indices.into_iter().zip(areas) {
-            weights[i] = area;
-        }
-    }
-    weights
+    disk_voronoi_areas(&points)
 }
 
 /// Lambert azimuthal equal-area projection of a direction about the normal
