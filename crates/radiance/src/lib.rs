@@ -10,7 +10,10 @@
 //! scene (`docs/radiance.md`).
 
 pub mod export;
+mod name;
 mod primitive;
+
+pub use name::default_fit_name;
 
 pub use primitive::{
     Primitive, RadError, format_primitive, identifier, material_from_primitive, parse_primitives,
