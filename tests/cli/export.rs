@@ -60,6 +60,7 @@ fn report(kind: MaterialKind, theta_in: f64, args: &[f64]) -> FitReport {
         n_points: 2000,
         gates: Vec::new(),
         weighting: brtf_fit::Weighting::Caller,
+        patch_pairs: None,
         rms_rel: 0.012,
         cost: 0.5,
         floor: 0.0,
@@ -154,6 +155,7 @@ fn result_of(
                     phi_in: r.phi_in,
                     conversion: brtf_fit::Conversion::Bsdf,
                     samples: 2000,
+                    klems: None,
                 })
                 .collect(),
         },
@@ -918,5 +920,6 @@ fn synthetic(material: &Material, theta_in: f64) -> IncidenceData {
         samples,
         gates: Vec::new(),
         weighting: brtf_fit::Weighting::Caller,
+        patch_pairs: None,
     }
 }

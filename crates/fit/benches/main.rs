@@ -56,6 +56,7 @@ pub fn bench_data() -> (Material, IncidenceData) {
         samples,
         gates: Vec::new(),
         weighting: brtf_fit::Weighting::Caller,
+        patch_pairs: None,
     };
     (truth, data)
 }

@@ -94,6 +94,15 @@ pub struct FitConfig {
     pub loss: RobustLoss,
     /// Try several starting roughnesses and keep the best.
     pub multistart: bool,
+    /// Lowest roughness the fit may reach. Klems fits raise it to
+    /// [`crate::klems::MIN_KLEMS_ROUGHNESS`]: a narrower lobe fits inside
+    /// one patch, so patch averages cannot tell its width.
+    #[serde(default = "default_min_roughness")]
+    pub min_roughness: f64,
+}
+
+fn default_min_roughness() -> f64 {
+    crate::MIN_ROUGHNESS
 }
 
 impl FitConfig {
@@ -109,6 +118,7 @@ impl FitConfig {
             floor: None,
             loss: RobustLoss::None,
             multistart: true,
+            min_roughness: crate::MIN_ROUGHNESS,
         }
     }
 }

@@ -5,6 +5,7 @@
 use brtf_gonio::Gate;
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
+use std::sync::Arc;
 
 /// One measured direction.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -71,11 +72,101 @@ pub struct IncidenceData {
     pub gates: Vec<GateCount>,
     /// Which weights the samples carry.
     pub weighting: Weighting,
+    /// For patch-averaged data (Klems): the direction pairs the model is
+    /// averaged over for each sample. `None`: the model is evaluated at
+    /// each sample's own direction.
+    pub patch_pairs: Option<Arc<PatchPairs>>,
+}
+
+/// The (light, view) pairs over which the model is averaged for each
+/// sample of patch-averaged data: Klems values are the BSDF averaged over
+/// an outgoing patch (projected-solid-angle weighted) and an incident
+/// patch, so the model must be averaged the same way to be compared with
+/// them. Pairs are fixed when the data are prepared, so the objective is a
+/// smooth function of the parameters.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct PatchPairs {
+    /// Start of sample i's pairs is `offsets[i]`, its end `offsets[i + 1]`.
+    pub offsets: Vec<usize>,
+    /// Unit vectors towards the light, one per pair.
+    pub lights: Vec<DVec3>,
+    /// Unit vectors towards the detector, one per pair.
+    pub views: Vec<DVec3>,
+}
+
+impl PatchPairs {
+    /// No samples yet.
+    pub fn new() -> PatchPairs {
+        PatchPairs {
+            offsets: vec![0],
+            lights: Vec::new(),
+            views: Vec::new(),
+        }
+    }
+
+    /// Appends one sample's pairs.
+    pub fn push(&mut self, pairs: impl IntoIterator<Item = (DVec3, DVec3)>) {
+        for (light, view) in pairs {
+            self.lights.push(light);
+            self.views.push(view);
+        }
+        self.offsets.push(self.lights.len());
+    }
+
+    /// How many samples.
+    pub fn len(&self) -> usize {
+        self.offsets.len().saturating_sub(1)
+    }
+
+    /// True when there are no samples.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The pairs of sample `i`: (lights, views).
+    #[inline]
+    pub fn of(&self, i: usize) -> (&[DVec3], &[DVec3]) {
+        let range = self.offsets[i]..self.offsets[i + 1];
+        (&self.lights[range.clone()], &self.views[range])
+    }
+
+    /// The pairs of the samples `indices`, in that order.
+    pub fn select(&self, indices: impl IntoIterator<Item = usize>) -> PatchPairs {
+        let mut out = PatchPairs::new();
+        for i in indices {
+            let (lights, views) = self.of(i);
+            out.push(lights.iter().copied().zip(views.iter().copied()));
+        }
+        out
+    }
+
+    /// The BSDF of sample `i` averaged over its pairs.
+    pub fn average(&self, bsdf: &brtf_model::Bsdf, i: usize) -> [f64; 3] {
+        let (lights, views) = self.of(i);
+        let mut sum = [0.0; 3];
+        for (l, v) in lights.iter().zip(views) {
+            let f = bsdf.eval(*l, *v);
+            for (s, x) in sum.iter_mut().zip(f) {
+                *s += x;
+            }
+        }
+        let n = lights.len().max(1) as f64;
+        sum.map(|s| s / n)
+    }
 }
 
 impl IncidenceData {
     /// Unit vector towards the light.
     pub fn light(&self) -> DVec3 {
         brtf_model::direction(self.theta_in, self.phi_in)
+    }
+
+    /// The model value for sample `i`: averaged over its pairs for
+    /// patch-averaged data, else at its direction.
+    pub fn model_value(&self, bsdf: &brtf_model::Bsdf, i: usize) -> [f64; 3] {
+        match &self.patch_pairs {
+            Some(pairs) => pairs.average(bsdf, i),
+            None => bsdf.eval(self.light(), self.samples[i].view),
+        }
     }
 }

@@ -110,13 +110,12 @@ pub(crate) fn measured_integrals(
     scale: f64,
 ) -> Measured {
     let channels = prepared.channels();
-    let light = prepared.measurement.incident_direction();
     let mut sums = [[0.0; 2]; 2];
     let mut seen = [false; 2];
-    for (_, s) in prepared.fitted() {
+    for (i, s) in prepared.fitted() {
         let weight = s.solid_angle_sr.unwrap_or(0.0) * s.abs_cos_theta();
         let side = usize::from(s.hemisphere() == Hemisphere::Back);
-        let f = bsdf.eval(light, s.direction());
+        let f = prepared.model_value(bsdf, i);
         sums[side][0] += weight * luminance(s.values, channels);
         sums[side][1] += weight * scale * luminance(f, channels);
         seen[side] = true;
@@ -169,13 +168,12 @@ pub(crate) fn diagnose(
 /// brightest samples are less than twice their median).
 fn peak_offset(prepared: &PreparedMeasurement, bsdf: &Bsdf) -> Option<f64> {
     let channels = prepared.channels();
-    let light = prepared.measurement.incident_direction();
     let samples: Vec<(DVec3, f64, f64)> = prepared
         .fitted()
-        .map(|(_, s)| {
+        .map(|(i, s)| {
             let v = s.direction();
             let y = luminance(s.values, channels);
-            (v, y, luminance(bsdf.eval(light, v), channels))
+            (v, y, luminance(prepared.model_value(bsdf, i), channels))
         })
         .filter(|(_, y, _)| y.is_finite())
         .collect();

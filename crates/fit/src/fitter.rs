@@ -57,7 +57,8 @@ fn fit_many(
         return Err(FitError::MixedChannels);
     }
     let gray = config.gray || channels == 1;
-    let map = ParamMap::new(config.kind, gray, config.free_scale);
+    let map = ParamMap::new(config.kind, gray, config.free_scale)
+        .with_min_roughness(config.min_roughness);
     let mut blocks = Vec::with_capacity(data.len());
     let mut stats = Vec::with_capacity(data.len());
     for d in data {

@@ -33,6 +33,7 @@ mod config;
 mod data;
 mod diagnose;
 mod fitter;
+pub mod klems;
 mod params;
 mod prepare;
 mod problem;
@@ -65,7 +66,7 @@ pub(crate) mod serde_kind {
 
 pub use brtf_gonio::Gate;
 pub use config::{FitConfig, FitError, KnownReflectance, RobustLoss};
-pub use data::{FitSample, GateCount, IncidenceData, Weighting};
+pub use data::{FitSample, GateCount, IncidenceData, PatchPairs, Weighting};
 pub use diagnose::{
     Adequacy, ENERGY_TOLERANCE, PEAK_TOLERANCE_DEG, RESIDUAL_KIND_TOLERANCE, ResidualCheck,
 };
@@ -73,13 +74,15 @@ pub use fitter::{fit_global, fit_incidence};
 pub use params::{MAX_ROUGHNESS, MIN_ROUGHNESS, ParamMap, Slot, Target};
 pub use problem::ResidualKind;
 pub use recipe::{
-    BeamOrigin, ColourConversion, Conversion, DataUnit, PreparedMeasurement, RawScale, Recipe,
-    RecipeError, ScaleRule, WeightRule,
+    BeamOrigin, ColourConversion, Conversion, DataUnit, PatchAveraging, PreparedMeasurement,
+    RawScale, Recipe, RecipeError, ScaleRule, WeightRule,
 };
 pub use report::{
     FitReport, FitWarning, ParamEstimate, RobustRecord, StartRecord, StderrRatio, Termination,
 };
 pub use result::{FIT_JSON_SCHEMA, FitResult, InputFile, Provenance, ReadFitError, SetWarning};
-pub use set::{FitSetError, FitSetOptions, NoProgress, Progress, fit_set};
+pub use set::{
+    FitSetError, FitSetOptions, KlemsOptions, NoProgress, Progress, fit_set, prepare_input,
+};
 pub use summary::summary;
 pub use table::{Interpolation, ParamTable, TableError, TableLookup};

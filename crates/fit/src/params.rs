@@ -96,6 +96,18 @@ impl ParamMap {
         ParamMap { kind, slots, fixed }
     }
 
+    /// The same map with roughness bounded below by `min` (never below
+    /// [`MIN_ROUGHNESS`]).
+    pub fn with_min_roughness(mut self, min: f64) -> ParamMap {
+        let min = min.clamp(MIN_ROUGHNESS, 0.5 * MAX_ROUGHNESS);
+        for slot in &mut self.slots {
+            if slot.name.starts_with("rough") {
+                slot.lo = min;
+            }
+        }
+        self
+    }
+
     /// Number of free parameters.
     pub fn len(&self) -> usize {
         self.slots.len()

@@ -173,6 +173,7 @@ pub(crate) fn scan<'a>(
         block: Block {
             light,
             samples: Cow::Borrowed(&d.samples),
+            pairs: d.patch_pairs.as_deref().map(Cow::Borrowed),
             weight_scale: if unit_weights {
                 1.0
             } else {
@@ -226,6 +227,7 @@ pub(crate) fn subsample<'a>(b: &Block<'_>, target: usize, bright: f64) -> Block<
     let step = (b.len() / target.max(1)).max(1);
     let channels = b.channels;
     let mut samples = Vec::new();
+    let mut kept = Vec::new();
     let mut multipliers = Vec::new();
     let mut factors = Vec::new();
     let expand = (step as f64).sqrt();
@@ -239,6 +241,7 @@ pub(crate) fn subsample<'a>(b: &Block<'_>, target: usize, bright: f64) -> Block<
             continue;
         };
         samples.push(*s);
+        kept.push(i);
         multipliers.push(m * b.multipliers.as_ref().map_or(1.0, |r| r[i]));
         factors.extend(
             b.factors[i * channels..(i + 1) * channels]
@@ -249,6 +252,7 @@ pub(crate) fn subsample<'a>(b: &Block<'_>, target: usize, bright: f64) -> Block<
     Block {
         light: b.light,
         samples: Cow::Owned(samples),
+        pairs: b.pairs.as_ref().map(|p| Cow::Owned(p.select(kept))),
         weight_scale: b.weight_scale,
         unit_weights: b.unit_weights,
         multipliers: Some(multipliers),

@@ -2,7 +2,7 @@
 //! residuals and the exact Jacobian from brtf-model's analytic gradients,
 //! in the unconstrained coordinates of [`ParamMap`].
 
-use crate::data::FitSample;
+use crate::data::{FitSample, PatchPairs};
 use crate::params::{ParamMap, Target};
 use brtf_model::{Bsdf, EvalOptions, Gradient, Material};
 use glam::DVec3;
@@ -40,6 +40,10 @@ pub(crate) struct Block<'a> {
     /// them on every pass: that costs a few operations per sample, while
     /// storing it would cost as much memory traffic as reading the samples.
     pub samples: Cow<'a, [FitSample]>,
+    /// Patch-averaged data: the (light, view) pairs each sample's model
+    /// value is averaged over (then `light` and the samples' views are
+    /// not used by the kernel).
+    pub pairs: Option<Cow<'a, PatchPairs>>,
     /// √(weight) of sample i is `√max(wᵢ, 0) · weight_scale` (or
     /// `weight_scale` alone with `unit_weights`), times `multipliers[i]`
     /// when a robust loss has reweighted the samples or a subsample stands
@@ -343,7 +347,10 @@ impl Kernel<'_> {
         let mut sum_rel = 0.0;
         for i in start..end {
             let s = &block.samples[i];
-            let f = self.bsdf.eval(block.light, s.view);
+            let f = match &block.pairs {
+                Some(pairs) => pairs.average(&self.bsdf, i),
+                None => self.bsdf.eval(block.light, s.view),
+            };
             for ch in 0..channels {
                 let row = i * channels + ch;
                 let (res, _, rel2) = self.residual(f[ch], s.value[ch], block.factors[row]);
@@ -372,12 +379,9 @@ impl Kernel<'_> {
         let mut sum_rel = 0.0;
         for i in start..end {
             let s = &block.samples[i];
-            let g = &self.bsdf.geometry(block.light, s.view);
-            let f = if channels == 1 {
-                self.bsdf
-                    .eval_geometry_channels_with_gradient::<1>(g, &mut grad)
-            } else {
-                self.bsdf.eval_geometry_with_gradient(g, &mut grad)
+            let f = match &block.pairs {
+                Some(pairs) => self.average_with_gradient(pairs, i, &mut grad),
+                None => self.value_with_gradient(block.light, s.view, &mut grad),
             };
             for ch in 0..channels {
                 let row = i * channels + ch;
@@ -420,6 +424,44 @@ impl Kernel<'_> {
             data,
             sum_rel,
         }
+    }
+
+    /// The BSDF at (light, view) and its gradient (channel 0 only for
+    /// one-channel fits).
+    #[inline(always)]
+    fn value_with_gradient(&self, light: DVec3, view: DVec3, grad: &mut Gradient) -> [f64; 3] {
+        let g = &self.bsdf.geometry(light, view);
+        if self.channels == 1 {
+            self.bsdf.eval_geometry_channels_with_gradient::<1>(g, grad)
+        } else {
+            self.bsdf.eval_geometry_with_gradient(g, grad)
+        }
+    }
+
+    /// The BSDF and its gradient averaged over sample `i`'s pairs: the
+    /// patch average is linear, so its gradient is the average gradient.
+    fn average_with_gradient(&self, pairs: &PatchPairs, i: usize, grad: &mut Gradient) -> [f64; 3] {
+        let (lights, views) = pairs.of(i);
+        let mut sum = [0.0; 3];
+        let mut sum_grad = Gradient::default();
+        for (&light, &view) in lights.iter().zip(views) {
+            let f = self.value_with_gradient(light, view, grad);
+            for c in 0..3 {
+                sum[c] += f[c];
+            }
+            for (total, d) in sum_grad.d.iter_mut().zip(&grad.d) {
+                for c in 0..3 {
+                    total[c] += d[c];
+                }
+            }
+        }
+        let inverse = 1.0 / lights.len().max(1) as f64;
+        for (out, total) in grad.d.iter_mut().zip(&sum_grad.d) {
+            for c in 0..3 {
+                out[c] = total[c] * inverse;
+            }
+        }
+        sum.map(|s| s * inverse)
     }
 
     /// The residual for BSDF value `f`, measured `y` and factor `k`, dr/dm,

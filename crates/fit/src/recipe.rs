@@ -87,6 +87,39 @@ pub struct Recipe {
     pub selections: Vec<Gate>,
     /// The fit's weights.
     pub weights: WeightRule,
+    /// Klems patch averages: the data are BSDF averages over patches, and
+    /// the model is averaged the same way before it is compared with them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub patch_average: Option<PatchAveraging>,
+}
+
+/// How the model is averaged over Klems patches (see
+/// [`crate::klems`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PatchAveraging {
+    /// Stratified directions per outgoing patch.
+    pub outgoing_samples: usize,
+    /// Stratified directions per incident patch.
+    pub incident_samples: usize,
+    /// Outgoing patches whose centre lies within this angle (degrees) of
+    /// the mirror or straight-through direction of the incident patch's
+    /// centre are averaged over every pairing of incident and outgoing
+    /// directions (`incident_samples × outgoing_samples` pairs), so that
+    /// narrow lobes are resolved; the others pair them one to one.
+    pub near_lobe_deg: f64,
+    /// Seed of the stratified directions.
+    pub seed: u64,
+}
+
+impl Default for PatchAveraging {
+    fn default() -> Self {
+        PatchAveraging {
+            outgoing_samples: 32,
+            incident_samples: 8,
+            near_lobe_deg: 25.0,
+            seed: 1,
+        }
+    }
 }
 
 impl Recipe {
@@ -112,6 +145,27 @@ impl Recipe {
             colour: ColourConversion::XyzToRadianceRgb,
             selections,
             weights: WeightRule::SolidAngle,
+            patch_average: None,
+        }
+    }
+
+    /// The recipe for Klems patch averages: no beam mask or θ cap (the
+    /// diagonal patch holds the peak and the last ring reaches 90°), the
+    /// front hemisphere only for reflecting models, patch weights, and
+    /// the model averaged over patches.
+    pub fn for_klems(kind: brtf_model::MaterialKind) -> Recipe {
+        let mut selections = vec![Gate::Unavailable];
+        if !kind.is_transmitting() {
+            selections.push(Gate::Hemisphere {
+                keep: brtf_gonio::Hemisphere::Front,
+            });
+        }
+        Recipe {
+            scale: ScaleRule::FromFiles,
+            colour: ColourConversion::XyzToRadianceRgb,
+            selections,
+            weights: WeightRule::SolidAngle,
+            patch_average: Some(PatchAveraging::default()),
         }
     }
 }
@@ -287,6 +341,9 @@ pub struct PreparedMeasurement {
     pub gates: Vec<GateCount>,
     /// Which weights the fitted samples carry.
     pub weighting: Weighting,
+    /// Patch-averaged data: every sample's (light, view) pairs, in file
+    /// order (set by [`crate::klems`]).
+    pub patch_pairs: Option<std::sync::Arc<crate::data::PatchPairs>>,
 }
 
 impl Recipe {
@@ -334,6 +391,7 @@ impl Recipe {
             removed_by,
             gates,
             weighting,
+            patch_pairs: None,
         })
     }
 
@@ -421,6 +479,19 @@ impl PreparedMeasurement {
             .map(|(i, (s, _))| (i, s))
     }
 
+    /// The model value the fit compares with sample `index` (file order):
+    /// averaged over the sample's patch pairs for patch-averaged data,
+    /// else the BSDF at the sample's direction.
+    pub fn model_value(&self, bsdf: &brtf_model::Bsdf, index: usize) -> [f64; 3] {
+        match &self.patch_pairs {
+            Some(pairs) => pairs.average(bsdf, index),
+            None => bsdf.eval(
+                self.measurement.incident_direction(),
+                self.measurement.samples[index].direction(),
+            ),
+        }
+    }
+
     /// How many samples the fit uses.
     pub fn fitted_count(&self) -> usize {
         self.removed_by.iter().filter(|r| r.is_none()).count()
@@ -467,6 +538,10 @@ impl PreparedMeasurement {
                 .collect(),
             gates: self.gates.clone(),
             weighting: self.weighting,
+            patch_pairs: self
+                .patch_pairs
+                .as_ref()
+                .map(|pairs| std::sync::Arc::new(pairs.select(self.fitted().map(|(i, _)| i)))),
         }
     }
 }

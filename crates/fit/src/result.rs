@@ -32,6 +32,21 @@ pub struct InputFile {
     pub conversion: Conversion,
     /// Samples in the file.
     pub samples: usize,
+    /// For a Klems BSDF XML file: which incident patch of which side this
+    /// incidence is (one file gives many incidences).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub klems: Option<crate::klems::KlemsPatchRef>,
+}
+
+impl InputFile {
+    /// The name its incidence's report carries as `source`: the path, or
+    /// for a Klems patch `path [front patch 12]`.
+    pub fn label(&self) -> String {
+        match &self.klems {
+            Some(k) => format!("{} [{} patch {}]", self.path, k.side, k.patch),
+            None => self.path.clone(),
+        }
+    }
 }
 
 /// Where and how a result was made.
@@ -276,7 +291,7 @@ impl FitResult {
         self.provenance
             .inputs
             .iter()
-            .find(|i| i.path == report.source)
+            .find(|i| i.label() == report.source)
             .or_else(|| self.provenance.inputs.get(index))
     }
 

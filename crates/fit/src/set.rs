@@ -48,6 +48,18 @@ pub struct FitSetOptions {
     /// Judge each incidence's fit (energy, peak, a second fit with another
     /// residual kind; see [`crate::Adequacy`]).
     pub adequacy: bool,
+    /// What to take from Klems BSDF XML inputs.
+    pub klems: KlemsOptions,
+}
+
+/// What a fit set takes from Klems BSDF XML files.
+#[derive(Debug, Clone, Default)]
+pub struct KlemsOptions {
+    /// The side whose incident patches are fitted (each side is its own
+    /// fit: measured fabrics are not reciprocal).
+    pub side: Option<brtf_gonio::klems::Side>,
+    /// Which incident patches (by θ_in); all when `None`.
+    pub incidences: Option<crate::klems::IncidenceFilter>,
 }
 
 /// Why a fit set could not be made.
@@ -83,6 +95,11 @@ pub enum FitSetError {
     /// The fitted model reflects nothing at the `--rho` incidence.
     #[error("--rho: the fitted model has no reflectance at {0}°")]
     NoReflectance(f64),
+    /// The selection left no incidence to fit.
+    #[error(
+        "no incidence to fit: the Klems file has no data for this side, or --incidences excludes every patch"
+    )]
+    NoIncidences,
 }
 
 /// One input file, read and prepared.
@@ -101,10 +118,14 @@ pub fn fit_set(
         return Err(FitSetError::NoInputs);
     }
     let mut recipe = options.recipe.clone();
-    let mut inputs: Vec<Input> = paths
+    let per_path: Vec<Vec<Input>> = paths
         .par_iter()
-        .map(|p| read_input(p, &recipe))
+        .map(|p| read_input(p, &recipe, &options.klems))
         .collect::<Result<_, _>>()?;
+    let mut inputs: Vec<Input> = per_path.into_iter().flatten().collect();
+    if inputs.is_empty() {
+        return Err(FitSetError::NoIncidences);
+    }
     inputs.sort_by(|a, b| a.file.theta_in.total_cmp(&b.file.theta_in));
 
     let mut config = options.config.clone();
@@ -193,28 +214,83 @@ pub fn fit_set(
     })
 }
 
-/// Reads one file and applies the recipe.
-fn read_input(path: &Path, recipe: &Recipe) -> Result<Input, FitSetError> {
+/// Reads one file and applies the recipe: one input, or for a Klems file
+/// one per incident patch of the chosen side.
+fn read_input(
+    path: &Path,
+    recipe: &Recipe,
+    klems: &KlemsOptions,
+) -> Result<Vec<Input>, FitSetError> {
     let bytes = std::fs::read(path).map_err(|source| FitSetError::Io {
         path: path.to_path_buf(),
         source,
     })?;
+    let sha256 = brtf_io::sha256_hex(&bytes);
+    let source = path.display().to_string();
+    let input = |prepared: PreparedMeasurement, samples, at| {
+        let incidence = prepared.measurement.incidence;
+        Input {
+            file: InputFile {
+                path: source.clone(),
+                sha256: sha256.clone(),
+                theta_in: incidence.theta_deg,
+                phi_in: incidence.phi_deg,
+                conversion: prepared.conversion.clone(),
+                samples,
+                klems: at,
+            },
+            prepared,
+        }
+    };
+    if brtf_gonio::detect_format(&bytes, path) == brtf_gonio::SourceFormat::KlemsXml {
+        let bsdf = brtf_gonio::klems::read_bytes(&bytes, path)?;
+        let side = klems.side.unwrap_or(brtf_gonio::klems::Side::Front);
+        let mut inputs = Vec::new();
+        for patch in 0..bsdf.basis.len() {
+            let at = crate::klems::KlemsPatchRef { side, patch };
+            let theta = bsdf.basis.patch(patch).map_or(f64::NAN, |p| p.theta_deg);
+            if klems.incidences.as_ref().is_some_and(|f| !f.keeps(theta)) {
+                continue;
+            }
+            let label = format!("{source} [{side} patch {patch}]");
+            let Some(mut prepared) = crate::klems::prepare_patch(recipe, &bsdf, at, &label)? else {
+                continue;
+            };
+            prepared.source = label;
+            let samples = prepared.measurement.len();
+            inputs.push(input(prepared, samples, Some(at)));
+        }
+        return Ok(inputs);
+    }
     let measurement = brtf_gonio::read_bytes(&bytes, path)?;
     let samples = measurement.len();
-    let source = path.display().to_string();
     let prepared = recipe.prepare(measurement, &source)?;
-    let incidence = prepared.measurement.incidence;
-    Ok(Input {
-        file: InputFile {
-            path: source,
-            sha256: brtf_io::sha256_hex(&bytes),
-            theta_in: incidence.theta_deg,
-            phi_in: incidence.phi_deg,
-            conversion: prepared.conversion.clone(),
-            samples,
-        },
-        prepared,
-    })
+    Ok(vec![input(prepared, samples, None)])
+}
+
+/// Rebuilds the fitted data of one input file of a fit, from the file's
+/// bytes and the fit's recipe, exactly as the fit made it: what plots and
+/// checks use.
+pub fn prepare_input(
+    recipe: &Recipe,
+    input: &InputFile,
+    bytes: &[u8],
+    path: &Path,
+) -> Result<PreparedMeasurement, FitSetError> {
+    let label = input.label();
+    match input.klems {
+        Some(at) => {
+            let bsdf = brtf_gonio::klems::read_bytes(bytes, path)?;
+            let mut prepared = crate::klems::prepare_patch(recipe, &bsdf, at, &label)?
+                .ok_or(FitSetError::NoIncidences)?;
+            prepared.source = label;
+            Ok(prepared)
+        }
+        None => {
+            let measurement = brtf_gonio::read_bytes(bytes, path)?;
+            Ok(recipe.prepare(measurement, &input.path)?)
+        }
+    }
 }
 
 /// K such that the data ÷ K have the reflectance `rho` at their incidence:

@@ -66,11 +66,13 @@ mod tests {
                 colour: ColourConversion::AsRecorded,
                 selections: vec![Gate::ThetaCap { max_deg: 85.0 }],
                 weights: WeightRule::SolidAngle,
+                patch_average: None,
             },
             known_reflectance: None,
             interpolation: Interpolation::Pchip,
             command_line: Vec::new(),
             adequacy: false,
+            klems: Default::default(),
         }
     }
 

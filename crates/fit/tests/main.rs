@@ -79,6 +79,7 @@ fn synth(material: &Material, theta_in: f64, phi_in: f64, noise: f64, seed: u64)
         samples,
         gates: Vec::new(),
         weighting: brtf_fit::Weighting::Caller,
+        patch_pairs: None,
     }
 }
 
@@ -300,6 +301,7 @@ fn narrow_lobe_on_a_dense_uniform_grid_is_recovered() {
             samples,
             gates: Vec::new(),
             weighting: brtf_fit::Weighting::Caller,
+            patch_pairs: None,
         };
         let report = fit_incidence(&data, &FitConfig::new(MaterialKind::Metal)).unwrap();
         let (spec, fitted_rough) = (

@@ -42,10 +42,12 @@ pub mod colour;
 pub mod disk;
 mod error;
 pub mod figure;
+pub mod klems;
 pub mod prepare;
 pub mod report;
 
 pub use error::PlotError;
+pub use klems::klems_sides_report;
 
 use brtf_fit::FitResult;
 use charts::cut::{CutChart, CutsChart};

@@ -89,6 +89,7 @@ fn fit(
                     phi_in: 0.0,
                     conversion: brtf_fit::Conversion::Bsdf,
                     samples: 8100,
+                    klems: None,
                 })
                 .collect(),
         },

@@ -306,17 +306,16 @@ fn fitted_directions(
     } else {
         1e-6
     };
-    let located = fit
-        .input_of(index)
-        .and_then(|input| brtf_io::locate_input(&input.path, dir, &options.search_dirs));
-    let Some(path) = located else {
+    let input = fit.input_of(index);
+    let located = input
+        .and_then(|input| brtf_io::locate_input(&input.path, dir, &options.search_dirs))
+        .zip(input);
+    let Some((path, input)) = located else {
         return Ok(model_grid(report, floor, beam_mask(fit)));
     };
     let data = |e: String| CheckError::Data(format!("{}: {e}", path.display()));
-    let m = brtf_gonio::read_path(&path).map_err(|e| data(e.to_string()))?;
-    let prepared = fit
-        .recipe
-        .prepare(m, &path.display().to_string())
+    let bytes = std::fs::read(&path).map_err(|e| data(e.to_string()))?;
+    let prepared = brtf_fit::prepare_input(&fit.recipe, input, &bytes, &path)
         .map_err(|e| data(e.to_string()))?;
     let channels = prepared.channels();
     let stride = prepared

@@ -7,6 +7,7 @@ use brtf_fit::{
     ResidualKind, RobustLoss, ScaleRule, WeightRule,
 };
 use brtf_gonio::Hemisphere;
+use brtf_gonio::klems::Side;
 use brtf_model::MaterialKind;
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
@@ -104,6 +105,47 @@ pub struct FitArgs {
     /// Do not draw the plots.
     #[arg(long)]
     pub no_plots: bool,
+    /// Klems XML: the side(s) fitted, each on its own (front = light from
+    /// +z, Radiance's front; WINDOW calls it the back).
+    #[arg(long, value_enum, default_value_t = SideArg::Both)]
+    pub side: SideArg,
+    /// Klems XML: which incident patches, e.g. `theta<=60` or
+    /// `theta>=10,theta<70` [default: all].
+    #[arg(long, value_parser = |s: &str| s.parse::<brtf_fit::klems::IncidenceFilter>())]
+    pub incidences: Option<brtf_fit::klems::IncidenceFilter>,
+    /// Klems XML: stratified directions per outgoing patch over which the
+    /// model is averaged.
+    #[arg(long, default_value_t = brtf_fit::PatchAveraging::default().outgoing_samples)]
+    pub patch_samples: usize,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, ValueEnum)]
+pub enum SideArg {
+    Front,
+    Back,
+    Both,
+}
+
+impl SideArg {
+    /// The sides fitted.
+    pub fn sides(self) -> Vec<Side> {
+        match self {
+            SideArg::Front => vec![Side::Front],
+            SideArg::Back => vec![Side::Back],
+            SideArg::Both => Side::BOTH.to_vec(),
+        }
+    }
+}
+
+/// True when `path` is a Klems BSDF XML file (by its extension or its
+/// first bytes), as `brtf_gonio::detect_format` decides.
+pub fn is_klems(path: &std::path::Path) -> bool {
+    use std::io::Read;
+    let mut head = Vec::new();
+    if let Ok(file) = std::fs::File::open(path) {
+        let _ = file.take(512).read_to_end(&mut head);
+    }
+    brtf_gonio::detect_format(&head, path) == brtf_gonio::SourceFormat::KlemsXml
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -156,20 +198,39 @@ impl FitArgs {
             None if self.model.is_transmitting() => None,
             None => Some(Hemisphere::Front),
         };
+        let klems = self.files.iter().filter(|f| is_klems(f)).count();
+        if klems > 0 && klems < self.files.len() {
+            bail!("Klems BSDF XML files are fitted on their own, not with gonio-photometer files");
+        }
+        let klems = klems > 0;
+        if !klems && self.incidences.is_some() {
+            bail!("--incidences selects the incident patches of Klems BSDF XML files");
+        }
+        if self.patch_samples == 0 || self.patch_samples > 4096 {
+            bail!("--patch-samples must be between 1 and 4096");
+        }
         let mut selections = vec![Gate::Unavailable];
         selections.extend(hemisphere.map(|keep| Gate::Hemisphere { keep }));
-        selections.push(Gate::ThetaCap {
-            max_deg: self.theta_cap,
-        });
-        if self.beam_mask > 0.0 {
-            selections.push(Gate::BeamMask {
-                half_angle_deg: self.beam_mask,
+        // Klems patches cover the hemisphere to 90° and the diagonal patch
+        // holds the peak: no θ cap, no beam mask.
+        if !klems {
+            selections.push(Gate::ThetaCap {
+                max_deg: self.theta_cap,
             });
+            if self.beam_mask > 0.0 {
+                selections.push(Gate::BeamMask {
+                    half_angle_deg: self.beam_mask,
+                });
+            }
         }
         selections.extend(self.min_value.map(|min| Gate::MinValue { min }));
         if self.mask_holder {
             selections.push(brtf_gonio::PGII_HOLDER_BAND);
         }
+        let patch_average = klems.then(|| brtf_fit::PatchAveraging {
+            outgoing_samples: self.patch_samples,
+            ..Default::default()
+        });
         let mut config = FitConfig::new(self.model);
         config.options.variant = self.formula.variant;
         config.options.fresnel_k = self.formula.fresnel_k;
@@ -185,6 +246,9 @@ impl FitArgs {
         config.floor = self.floor;
         config.loss = self.loss;
         config.multistart = !self.no_multistart;
+        if klems {
+            config.min_roughness = brtf_fit::klems::MIN_KLEMS_ROUGHNESS;
+        }
         Ok(FitSetOptions {
             name,
             config,
@@ -202,6 +266,7 @@ impl FitArgs {
                     WeightsArg::SolidAngle => WeightRule::SolidAngle,
                     WeightsArg::Uniform => WeightRule::Uniform,
                 },
+                patch_average,
             },
             known_reflectance: self.rho.map(|k| (k.rho, k.theta_in)),
             interpolation: match self.interpolation {
@@ -210,6 +275,10 @@ impl FitArgs {
             },
             command_line: std::env::args().collect(),
             adequacy: !self.no_adequacy,
+            klems: brtf_fit::KlemsOptions {
+                side: None,
+                incidences: self.incidences.clone(),
+            },
         })
     }
 }

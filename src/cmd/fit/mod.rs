@@ -5,9 +5,10 @@
 mod args;
 
 use crate::cmd::output::print;
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 pub use args::FitArgs;
 use brtf_fit::Progress;
+use brtf_gonio::klems::Side;
 use brtf_io::{FolderUpdate, Producer, describe_outputs};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
@@ -31,52 +32,109 @@ impl Progress for Bar {
 pub fn run(args: FitArgs) -> Result<()> {
     let mut options = args.options(String::new())?;
     options.validate()?;
+    let klems = args.files.iter().any(|f| args::is_klems(f));
     options.name = match &args.name {
         Some(name) => name.clone(),
-        None => default_name(&args.files)?,
+        None => default_name(&args.files, klems)?,
     };
     let out = args
         .out
         .clone()
         .unwrap_or_else(|| Path::new("fits").join(&options.name));
     let update = FolderUpdate::fresh(&out)?;
-    brtf_io::check_replaceable(update.target(), &args.files, args.force)?;
+    // A two-sided Klems fit is one folder per side.
+    let sides: Vec<Option<Side>> = if klems {
+        args.side.sides().into_iter().map(Some).collect()
+    } else {
+        vec![None]
+    };
+    let nested = sides.len() > 1;
+    if nested {
+        check_two_sided_replaceable(update.target(), &args)?;
+    } else {
+        brtf_io::check_replaceable(update.target(), &args.files, args.force)?;
+    }
     let bar = Bar(ProgressBar::new(0).with_style(
-        ProgressStyle::with_template("{spinner} fitting {pos}/{len} [{bar:30}] {elapsed} {msg}")
+        ProgressStyle::with_template("{spinner} fitting {msg}{pos}/{len} [{bar:30}] {elapsed}")
             .expect("valid template")
             .progress_chars("=> "),
     ));
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.jobs.unwrap_or(0))
         .build()?;
-    let mut result = pool.install(|| brtf_fit::fit_set(&args.files, &options, &bar))?;
-    let stage = update.path();
-    let context = || format!("writing the fit into {}", out.display());
+    let mut results = Vec::new();
+    let mut printed = String::new();
+    let mut notes = Vec::new();
+    for side in &sides {
+        let mut options = options.clone();
+        options.klems.side = *side;
+        if let Some(side) = side {
+            bar.0.set_message(format!("{side} side "));
+        }
+        let mut result = pool.install(|| brtf_fit::fit_set(&args.files, &options, &bar))?;
+        let (folder, shown) = match side {
+            Some(side) if nested => (update.path().join(side.name()), out.join(side.name())),
+            _ => (update.path().to_path_buf(), out.clone()),
+        };
+        std::fs::create_dir_all(&folder)
+            .with_context(|| format!("creating {}", folder.display()))?;
+        let lines = write_fit_folder(&folder, &shown, &mut result, &args, &mut notes)?;
+        printed += &format!("{}{lines}", brtf_fit::summary(&result, &shown));
+        results.push(result);
+    }
+    if nested {
+        let labels = Side::BOTH.map(|s| s.name().to_string());
+        let report = brtf_plot::klems_sides_report(&results, &labels, update.path());
+        brtf_io::write_atomic(&update.path().join("report.html"), report.as_bytes())
+            .with_context(|| format!("writing {}", out.join("report.html").display()))?;
+        printed += &format!("wrote {} (both sides)\n", out.join("report.html").display());
+    }
+    update.commit()?;
+    for result in &results {
+        for warning in &result.warnings {
+            say!("brtf: warning: {warning}");
+        }
+    }
+    for note in &notes {
+        say!("{note}");
+    }
+    print(&printed)
+}
+
+/// Writes one fit's folder (`fit.json`, `params.csv`, exports, plots) into
+/// `stage`, shown to the user as `shown`; returns the lines to print.
+fn write_fit_folder(
+    stage: &Path,
+    shown: &Path,
+    result: &mut brtf_fit::FitResult,
+    args: &FitArgs,
+    notes: &mut Vec<String>,
+) -> Result<String> {
+    let context = || format!("writing the fit into {}", shown.display());
     result.write(stage).with_context(context)?;
     let mut outputs = describe_outputs(stage, &[stage.join("params.csv")], Producer::Fit)?;
     let mut lines = String::new();
-    let mut notes = Vec::new();
     if !args.no_export {
         let options = brtf_radiance::export::ExportOptions::default();
-        let exported = brtf_radiance::export::write_exports(stage, &result, &options)
-            .with_context(|| format!("exporting Radiance materials into {}", out.display()))?;
+        let exported = brtf_radiance::export::write_exports(stage, result, &options)
+            .with_context(|| format!("exporting Radiance materials into {}", shown.display()))?;
         outputs.extend(describe_outputs(stage, &exported.files, Producer::Export)?);
         for file in &exported.files {
             let name = file.strip_prefix(stage).unwrap_or(file);
-            lines += &format!("wrote {}\n", out.join(name).display());
+            lines += &format!("wrote {}\n", shown.join(name).display());
         }
         notes.extend(exported.notes.iter().map(|n| format!("note: {n}")));
     }
     if !args.no_plots {
         let mut plot_options = brtf_plot::PlotOptions::default();
-        plot_options.search_dirs.push(out.clone());
-        let written = brtf_plot::write_plots(stage, &result, &plot_options)
-            .with_context(|| format!("plotting into {}", out.display()))?;
+        plot_options.search_dirs.push(shown.to_path_buf());
+        let written = brtf_plot::write_plots(stage, result, &plot_options)
+            .with_context(|| format!("plotting into {}", shown.display()))?;
         outputs.extend(describe_outputs(stage, &written.files, Producer::Plot)?);
         lines += &format!(
             "wrote {} plots and {}\n",
             written.files.len().saturating_sub(1),
-            out.join("report.html").display()
+            shown.join("report.html").display()
         );
         notes.extend(
             written
@@ -89,32 +147,55 @@ pub fn run(args: FitArgs) -> Result<()> {
     result.outputs = outputs;
     // fit.json last: it lists every other file of the folder.
     result.write(stage).with_context(context)?;
-    update.commit()?;
-    for warning in &result.warnings {
-        say!("brtf: warning: {warning}");
+    Ok(lines)
+}
+
+/// A two-sided Klems fit folder may be replaced when each side's folder
+/// may ([`brtf_io::check_replaceable`]) and nothing else is in it.
+fn check_two_sided_replaceable(target: &Path, args: &FitArgs) -> Result<()> {
+    let Ok(entries) = std::fs::read_dir(target) else {
+        return Ok(());
+    };
+    if args.force {
+        return brtf_io::check_replaceable(target, &args.files, true).map_err(Into::into);
     }
-    for note in &notes {
-        say!("{note}");
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let name = name.to_string_lossy();
+        match name.as_ref() {
+            "front" | "back" => {
+                brtf_io::check_replaceable(&entry.path(), &args.files, false)?;
+            }
+            "report.html" => {}
+            other => bail!(
+                "cannot replace the output folder {}: it holds {other}, which a two-sided Klems fit does not write; --force replaces it",
+                target.display()
+            ),
+        }
     }
-    print(&format!("{}{lines}", brtf_fit::summary(&result, &out)))
+    // Inputs inside the folder are refused whatever it holds.
+    brtf_io::check_replaceable(target, &args.files, true)?;
+    Ok(())
 }
 
 /// The material name: the files' `#sample_name` when they agree, else the
-/// longest common start of their file names, as a Radiance identifier
-/// (else `fit`; [`brtf_io::check_replaceable`] keeps it from replacing the
-/// fit of another sample).
-fn default_name(files: &[PathBuf]) -> Result<String> {
+/// longest common start of their file names ([`brtf_radiance::default_fit_name`];
+/// [`brtf_io::check_replaceable`] keeps `fit` from replacing the fit of
+/// another sample).
+fn default_name(files: &[PathBuf], klems: bool) -> Result<String> {
     let mut sample_names = Vec::new();
     for file in files {
-        let m = brtf_gonio::read_path(file)
-            .with_context(|| format!("cannot read {}", file.display()))?;
-        sample_names.push(m.sample_name);
-    }
-    if let Some(Some(first)) = sample_names.first()
-        && sample_names.iter().all(|n| n.as_ref() == Some(first))
-        && let Some(name) = brtf_radiance::identifier(first)
-    {
-        return Ok(name);
+        let name = if klems {
+            brtf_gonio::klems::read_path(file)
+                .with_context(|| format!("cannot read {}", file.display()))?
+                .header
+                .name
+        } else {
+            brtf_gonio::read_path(file)
+                .with_context(|| format!("cannot read {}", file.display()))?
+                .sample_name
+        };
+        sample_names.push(name);
     }
     let stems: Vec<String> = files
         .iter()
@@ -125,14 +206,5 @@ fn default_name(files: &[PathBuf]) -> Result<String> {
                 .into_owned()
         })
         .collect();
-    let common = stems.iter().fold(stems[0].clone(), |acc, s| {
-        acc.chars()
-            .zip(s.chars())
-            .take_while(|(a, b)| a == b)
-            .map(|(a, _)| a)
-            .collect()
-    });
-    // `alu:+30+0` and `alu:+45+0` share `alu:+`; the identifier drops the `:+`.
-    let common = common.split(':').next().unwrap_or_default();
-    Ok(brtf_radiance::identifier(common).unwrap_or_else(|| "fit".into()))
+    Ok(brtf_radiance::default_fit_name(&sample_names, &stems))
 }

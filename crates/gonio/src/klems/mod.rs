@@ -121,7 +121,7 @@ impl fmt::Display for KlemsDirection {
 }
 
 /// Radiance's side the light arrives from: front = +z, back = −z.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Side {
     /// Light from +z (Radiance's front, WINDOW's back): `rf`, `tf`.
@@ -424,64 +424,92 @@ impl KlemsBsdf {
     /// totals. The values are patch averages, not point values: the
     /// format says so. Side front first, patches in basis order.
     pub fn to_measurements(&self) -> Vec<Measurement> {
-        let channels = self.channels();
-        let mut out = Vec::new();
-        for side in Side::BOTH {
-            let blocks: Vec<(KlemsDirection, Side)> = [
-                (side.reflection(), side),
-                (side.transmission(), side.opposite()),
-            ]
+        Side::BOTH
             .into_iter()
-            .filter(|(d, _)| self.matrix(&KlemsBand::Visible, *d).is_some())
-            .collect();
-            if blocks.is_empty() {
-                continue;
+            .flat_map(|side| {
+                (0..self.basis.len()).filter_map(move |i| self.measurement(side, i, false))
+            })
+            .collect()
+    }
+
+    /// Incident patch `patch` lit from `side` as one [`Measurement`] (see
+    /// [`to_measurements`](Self::to_measurements)); `None` when the side
+    /// has no Visible block or the patch does not exist. With
+    /// `in_side_frame`, the back side is described mirrored (z → −z), as
+    /// if it were a front: the light on +z, reflection on +z and
+    /// transmission on −z. That is how a side is fitted on its own.
+    pub fn measurement(
+        &self,
+        side: Side,
+        patch: usize,
+        in_side_frame: bool,
+    ) -> Option<Measurement> {
+        let channels = self.channels();
+        let frame = |s: Side| {
+            if in_side_frame && side == Side::Back {
+                s.opposite()
+            } else {
+                s
             }
-            for i in 0..self.basis.len() {
-                let Some(incidence) = self.incidence(side, i) else {
-                    continue;
+        };
+        let blocks: Vec<(KlemsDirection, Side)> = [
+            (side.reflection(), frame(side)),
+            (side.transmission(), frame(side.opposite())),
+        ]
+        .into_iter()
+        .filter(|(d, _)| self.matrix(&KlemsBand::Visible, *d).is_some())
+        .collect();
+        if blocks.is_empty() {
+            return None;
+        }
+        let i = patch;
+        let mut incidence = self.incidence(side, i)?;
+        if in_side_frame {
+            incidence.theta_deg = self.basis.patch(i)?.theta_deg;
+        }
+        let mut samples = Vec::with_capacity(blocks.len() * self.basis.len());
+        for &(direction, sample_side) in &blocks {
+            let value_of = |band: &KlemsBand, o: usize| {
+                self.matrix(band, direction).map_or(0.0, |m| m.value(o, i))
+            };
+            for (o, patch) in self.basis.patches().iter().enumerate() {
+                let values = match channels {
+                    Channels::Y => [value_of(&KlemsBand::Visible, o), 0.0, 0.0],
+                    Channels::Xyz => [
+                        value_of(&KlemsBand::CieX, o),
+                        value_of(&KlemsBand::Visible, o),
+                        value_of(&KlemsBand::CieZ, o),
+                    ],
                 };
-                let mut samples = Vec::with_capacity(blocks.len() * self.basis.len());
-                for &(direction, sample_side) in &blocks {
-                    let value_of = |band: &KlemsBand, o: usize| {
-                        self.matrix(band, direction).map_or(0.0, |m| m.value(o, i))
-                    };
-                    for (o, patch) in self.basis.patches().iter().enumerate() {
-                        let values = match channels {
-                            Channels::Y => [value_of(&KlemsBand::Visible, o), 0.0, 0.0],
-                            Channels::Xyz => [
-                                value_of(&KlemsBand::CieX, o),
-                                value_of(&KlemsBand::Visible, o),
-                                value_of(&KlemsBand::CieZ, o),
-                            ],
-                        };
-                        samples.push(Sample {
-                            theta_deg: sample_side.theta_in_frame(patch.theta_deg),
-                            phi_deg: patch.phi_deg,
-                            values,
-                            solid_angle_sr: Some(patch.centre_weight_sr()),
-                        });
-                    }
-                }
-                let mut m = Measurement::new(
-                    SourceFormat::KlemsXml,
-                    incidence,
-                    Quantity::Bsdf,
-                    channels,
-                    samples,
-                );
-                m.sample_name = self.header.name.clone();
-                m.incidence_origin = IncidenceOrigin::Header;
-                m.header = vec![format!(
-                    "Klems patch averages: incident patch {i} of {} ({} patches), lit from the {side} (+z is front), from {}",
-                    self.basis.name,
-                    self.basis.len(),
-                    self.source
-                )];
-                out.push(m);
+                samples.push(Sample {
+                    theta_deg: sample_side.theta_in_frame(patch.theta_deg),
+                    phi_deg: patch.phi_deg,
+                    values,
+                    solid_angle_sr: Some(patch.centre_weight_sr()),
+                });
             }
         }
-        out
+        let mut m = Measurement::new(
+            SourceFormat::KlemsXml,
+            incidence,
+            Quantity::Bsdf,
+            channels,
+            samples,
+        );
+        m.sample_name = self.header.name.clone();
+        m.incidence_origin = IncidenceOrigin::Header;
+        let frame_note = if in_side_frame && side == Side::Back {
+            ", described mirrored (light on +z)"
+        } else {
+            ""
+        };
+        m.header = vec![format!(
+            "Klems patch averages: incident patch {i} of {} ({} patches), lit from the {side} (+z is front){frame_note}, from {}",
+            self.basis.name,
+            self.basis.len(),
+            self.source
+        )];
+        Some(m)
     }
 
     /// The summary `brtf info` prints.

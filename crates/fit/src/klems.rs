@@ -1,0 +1,216 @@
+//! Klems BSDF XML as fitted data: each incident patch of one side becomes
+//! one incidence whose samples are the outgoing patches, and the model is
+//! averaged over the patches before it is compared with them.
+//!
+//! A Klems value is the BSDF averaged over the outgoing patch (projected
+//! solid angle weighted) and, for files made by `bsdf2klems`, over the
+//! incident patch too. Evaluating the model at the patch centres is wrong
+//! by up to 50× for narrow lobes (`../shared/spec/klems-xml.md`), so each
+//! sample gets a fixed set of (light, view) pairs ([`PatchPairs`]):
+//!
+//! - the light directions are `incident_samples` stratified directions of
+//!   the incident patch, the view directions `outgoing_samples` stratified
+//!   directions of the outgoing patch, both uniform in projected solid
+//!   angle ([`KlemsPatch::stratified_directions`]);
+//! - near the mirror and straight-through directions, where a narrow lobe
+//!   makes the value depend on where within both patches the directions
+//!   fall, every light is paired with every view;
+//! - elsewhere, where the BSDF varies slowly, the views are paired one to
+//!   one with the lights in turn.
+//!
+//! The pairs are drawn once, from a fixed seed, so the fitted objective is
+//! a smooth, deterministic function of the parameters, and plots and
+//! checks that rebuild the data get the same pairs.
+
+use crate::data::PatchPairs;
+use crate::recipe::{PatchAveraging, PreparedMeasurement, Recipe, RecipeError};
+use brtf_gonio::klems::{KlemsBasis, KlemsBsdf, Side};
+use brtf_model::rng::Rng;
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+use std::sync::Arc;
+
+/// Which incident patch of a Klems file an incidence is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct KlemsPatchRef {
+    /// The side the light comes from (Radiance's front = +z).
+    pub side: Side,
+    /// The incident patch, in basis order.
+    pub patch: usize,
+}
+
+/// Lowest roughness of a Klems fit: a lobe narrower than this fits inside
+/// one Full-basis patch (5° to 30° across), so its width cannot be told
+/// from patch averages (`../shared/spec/klems-xml.md`), and stratified
+/// averages of so narrow a lobe are too coarse for a smooth objective.
+pub const MIN_KLEMS_ROUGHNESS: f64 = 0.05;
+
+/// Stream numbers of the incident patches' directions start here, far
+/// from the outgoing patches' (numbered by patch).
+const INCIDENT_STREAM: u64 = 1 << 32;
+
+/// Incident patch `patch` of `side` of `bsdf`, prepared by `recipe`, in
+/// the side's own frame (the light on +z; see
+/// [`KlemsBsdf::measurement`]), with its patch pairs when the recipe
+/// averages over patches. `None` when the side has no Visible data.
+pub fn prepare_patch(
+    recipe: &Recipe,
+    bsdf: &KlemsBsdf,
+    at: KlemsPatchRef,
+    source: &str,
+) -> Result<Option<PreparedMeasurement>, RecipeError> {
+    let Some(measurement) = bsdf.measurement(at.side, at.patch, true) else {
+        return Ok(None);
+    };
+    let mut prepared = recipe.prepare(measurement, source)?;
+    if let Some(rule) = recipe.patch_average {
+        prepared.patch_pairs = Some(Arc::new(patch_pairs(
+            &bsdf.basis,
+            at.patch,
+            &prepared,
+            &rule,
+        )));
+    }
+    Ok(Some(prepared))
+}
+
+/// The pairs of every sample of `prepared` (file order), incident patch
+/// `incident` of `basis`.
+fn patch_pairs(
+    basis: &KlemsBasis,
+    incident: usize,
+    prepared: &PreparedMeasurement,
+    rule: &PatchAveraging,
+) -> PatchPairs {
+    let light_centre = prepared.measurement.incidence.direction();
+    let mirror = DVec3::new(-light_centre.x, -light_centre.y, light_centre.z);
+    let near_cosine = rule.near_lobe_deg.to_radians().cos();
+    let lights: Vec<DVec3> = basis
+        .patch(incident)
+        .map(|p| {
+            p.stratified_directions(
+                rule.incident_samples,
+                &mut Rng::new(rule.seed, INCIDENT_STREAM + incident as u64),
+            )
+        })
+        .unwrap_or_default()
+        .into_iter()
+        // Incident patch (θ, φ) is the direction of travel: the light is
+        // at φ + 180°.
+        .map(|v| DVec3::new(-v.x, -v.y, v.z))
+        .collect();
+    let outgoing: Vec<Vec<DVec3>> = basis
+        .patches()
+        .iter()
+        .enumerate()
+        .map(|(o, p)| {
+            p.stratified_directions(rule.outgoing_samples, &mut Rng::new(rule.seed, o as u64))
+        })
+        .collect();
+    let mut pairs = PatchPairs::new();
+    for sample in &prepared.measurement.samples {
+        let transmitted = sample.theta_deg > 90.0;
+        let theta = if transmitted {
+            180.0 - sample.theta_deg
+        } else {
+            sample.theta_deg
+        };
+        let Some(o) = basis.patch_index(theta, sample.phi_deg) else {
+            pairs.push(std::iter::empty());
+            continue;
+        };
+        let to_side = |v: DVec3| {
+            if transmitted {
+                DVec3::new(v.x, v.y, -v.z)
+            } else {
+                v
+            }
+        };
+        let views: Vec<DVec3> = outgoing[o].iter().copied().map(to_side).collect();
+        // The lobe's centre for this side: the mirror direction, or the
+        // straight-through direction (the mirror's reflection through the
+        // surface).
+        let lobe = to_side(mirror);
+        let near = sample.direction().dot(lobe) >= near_cosine;
+        if near || lights.is_empty() {
+            pairs.push(
+                lights
+                    .iter()
+                    .flat_map(|&l| views.iter().map(move |&v| (l, v))),
+            );
+        } else {
+            pairs.push(
+                views
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &v)| (lights[k % lights.len()], v)),
+            );
+        }
+    }
+    pairs
+}
+
+/// Which incidences of a Klems file to fit: `theta<=60`, `theta>=10`,
+/// `theta<60`, `theta>10`, joined by commas (all must hold).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct IncidenceFilter {
+    /// The conditions, each `(operator, degrees)`.
+    pub conditions: Vec<(String, f64)>,
+}
+
+impl IncidenceFilter {
+    /// True when θ_in (degrees, in the side's frame) passes every condition.
+    pub fn keeps(&self, theta_in: f64) -> bool {
+        self.conditions.iter().all(|(op, value)| match op.as_str() {
+            "<=" => theta_in <= *value + 1e-9,
+            "<" => theta_in < *value - 1e-9,
+            ">=" => theta_in >= *value - 1e-9,
+            ">" => theta_in > *value + 1e-9,
+            _ => false,
+        })
+    }
+}
+
+impl std::str::FromStr for IncidenceFilter {
+    type Err = String;
+
+    fn from_str(text: &str) -> Result<Self, String> {
+        let mut conditions = Vec::new();
+        for part in text.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+            let rest = part.strip_prefix("theta").ok_or_else(|| {
+                format!("`{part}`: expected a condition on theta, such as theta<=60")
+            })?;
+            let rest = rest.trim_start();
+            let op = ["<=", ">=", "<", ">"]
+                .into_iter()
+                .find(|op| rest.starts_with(op))
+                .ok_or_else(|| format!("`{part}`: expected <=, >=, < or > after theta"))?;
+            let number = rest[op.len()..].trim();
+            let value: f64 = number
+                .parse()
+                .ok()
+                .filter(|v: &f64| v.is_finite())
+                .ok_or_else(|| format!("`{part}`: `{number}` is not a number of degrees"))?;
+            conditions.push((op.to_string(), value));
+        }
+        if conditions.is_empty() {
+            return Err("expected at least one condition, such as theta<=60".into());
+        }
+        Ok(IncidenceFilter { conditions })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn filters_parse_and_keep() {
+        let f: IncidenceFilter = "theta<=60, theta>5".parse().unwrap();
+        assert!(f.keeps(60.0) && f.keeps(10.0));
+        assert!(!f.keeps(70.0) && !f.keeps(5.0) && !f.keeps(0.0));
+        for bad in ["", "phi<3", "theta=4", "theta<=x"] {
+            assert!(bad.parse::<IncidenceFilter>().is_err(), "{bad}");
+        }
+    }
+}
