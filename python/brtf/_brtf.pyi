@@ -1,0 +1,215 @@
+"""Type stubs of the native module (crates/py)."""
+
+from __future__ import annotations
+
+import os
+from typing import Any, Literal, Optional, Sequence, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+PathLike = Union[str, os.PathLike]
+ArrayLike = npt.ArrayLike
+FloatArray = npt.NDArray[np.float64]
+
+class Measurement:
+    """One gonio-photometer scan: one incidence, N scattered samples."""
+
+    @property
+    def theta_in(self) -> float: ...
+    @property
+    def phi_in(self) -> float: ...
+    @property
+    def theta(self) -> FloatArray: ...
+    @property
+    def phi(self) -> FloatArray: ...
+    @property
+    def value(self) -> FloatArray:
+        """N × channels (1: CIE-Y; 3: CIE X, Y, Z); NaN = not available."""
+    @property
+    def solid_angle(self) -> FloatArray: ...
+    @property
+    def quantity(self) -> Literal["BSDF", "DSF", "raw"]: ...
+    @property
+    def unit(self) -> str: ...
+    @property
+    def beam_integral(self) -> Optional[float]: ...
+    @property
+    def channels(self) -> Literal["CIE-Y", "CIE-XYZ"]: ...
+    @property
+    def format(self) -> str: ...
+    @property
+    def sample_name(self) -> Optional[str]: ...
+    @property
+    def path(self) -> Optional[str]: ...
+    @property
+    def header(self) -> dict[str, str]: ...
+    @property
+    def header_lines(self) -> list[str]: ...
+    def __len__(self) -> int: ...
+
+def read(path: PathLike) -> Measurement: ...
+def read_klems(path: PathLike, side: Literal["front", "back", "both"] = "both") -> list[Measurement]: ...
+
+FresnelK = Union[Literal["classic", "pyradiance"], float]
+Variant = Literal["radiance", "manual2004", "ward1992"]
+Model = Literal["plastic", "metal", "trans", "plastic2", "metal2", "trans2"]
+
+class Albedo:
+    """ρ_dh, τ_dh and the delta parts, shape θ_in.shape + (3,)."""
+
+    @property
+    def rho(self) -> FloatArray: ...
+    @property
+    def tau(self) -> FloatArray: ...
+    @property
+    def rho_spike(self) -> FloatArray: ...
+    @property
+    def tau_spike(self) -> FloatArray: ...
+
+class Material:
+    def __init__(
+        self,
+        kind: Model,
+        rgb: Union[float, Sequence[float], None] = None,
+        spec: float = 0.0,
+        roughness: Union[float, Sequence[float], None] = None,
+        trans: Optional[float] = None,
+        tspec: Optional[float] = None,
+        *,
+        orientation: Optional[Sequence[float]] = None,
+        args: Optional[Sequence[float]] = None,
+        variant: Variant = "radiance",
+        fresnel_k: Optional[FresnelK] = None,
+        source_omega: float = 0.0,
+        curved: bool = False,
+    ) -> None: ...
+    @staticmethod
+    def from_rad(
+        text_or_path: Union[str, os.PathLike],
+        name: Optional[str] = None,
+        *,
+        variant: Variant = "radiance",
+        fresnel_k: Optional[FresnelK] = None,
+        source_omega: float = 0.0,
+        curved: bool = False,
+    ) -> Material: ...
+    @property
+    def kind(self) -> Model: ...
+    @property
+    def args(self) -> list[float]: ...
+    @property
+    def param_names(self) -> list[str]: ...
+    @property
+    def params(self) -> dict[str, float]: ...
+    @property
+    def orientation(self) -> list[float]: ...
+    @property
+    def name(self) -> Optional[str]: ...
+    @property
+    def variant(self) -> Variant: ...
+    @property
+    def fresnel_k(self) -> float: ...
+    @property
+    def source_omega(self) -> float: ...
+    def eval(self, theta_in: ArrayLike, phi_in: ArrayLike, theta_out: ArrayLike, phi_out: ArrayLike) -> FloatArray:
+        """BSDF (1/sr, no cosine), broadcast shape + (3,) for RGB."""
+    def albedo(self, theta_in: ArrayLike, phi_in: float = 0.0, tolerance: float = 1e-5) -> Albedo: ...
+    def to_rad(self, name: Optional[str] = None) -> str: ...
+
+class IncidenceFit:
+    @property
+    def theta_in(self) -> float: ...
+    @property
+    def phi_in(self) -> float: ...
+    @property
+    def source(self) -> str: ...
+    @property
+    def params(self) -> dict[str, float]: ...
+    @property
+    def stderr(self) -> dict[str, Optional[float]]: ...
+    @property
+    def stderr_robust(self) -> dict[str, Optional[float]]: ...
+    @property
+    def material_args(self) -> list[float]: ...
+    @property
+    def material(self) -> Optional[Material]: ...
+    @property
+    def scale(self) -> float: ...
+    @property
+    def cost(self) -> float: ...
+    @property
+    def rms_rel(self) -> float: ...
+    @property
+    def n_points(self) -> int: ...
+    @property
+    def termination(self) -> str: ...
+    @property
+    def converged(self) -> bool: ...
+    @property
+    def warnings(self) -> list[str]: ...
+    @property
+    def adequacy(self) -> Optional[dict[str, Any]]: ...
+    def to_dict(self) -> dict[str, Any]: ...
+
+class Fit:
+    @staticmethod
+    def load(folder: PathLike) -> Fit: ...
+    @property
+    def name(self) -> str: ...
+    @property
+    def model(self) -> Model: ...
+    @property
+    def incidences(self) -> list[IncidenceFit]: ...
+    @property
+    def global_fit(self) -> Optional[IncidenceFit]: ...
+    @property
+    def material(self) -> Optional[Material]: ...
+    @property
+    def warnings(self) -> list[str]: ...
+    def table(self, theta_in: ArrayLike) -> dict[str, FloatArray]: ...
+    def material_at(self, theta_in: float) -> Material: ...
+    def to_dict(self) -> dict[str, Any]: ...
+    def save(self, folder: PathLike, *, export: bool = True, plots: bool = True, force: bool = False) -> list[str]: ...
+    def export(
+        self,
+        folder: PathLike,
+        *,
+        at: Optional[float] = None,
+        name: Optional[str] = None,
+        static_only: bool = False,
+        preview: bool = True,
+        klems: Optional[Literal["full", "half", "quarter"]] = None,
+        klems_colour: bool = False,
+    ) -> list[str]: ...
+
+def fit(
+    inputs: Union[PathLike, Measurement, Sequence[Union[PathLike, Measurement]]],
+    model: Model = "metal",
+    *,
+    gray: bool = False,
+    residual: Literal["absolute", "relative", "log"] = "absolute",
+    loss: str = "none",
+    name: Optional[str] = None,
+    variant: Variant = "radiance",
+    fresnel_k: Optional[FresnelK] = None,
+    source_omega: float = 0.0,
+    orientation: Sequence[float] = (1.0, 0.0, 0.0),
+    floor: Optional[float] = None,
+    colour: Literal["xyz", "as_recorded"] = "xyz",
+    weights: Literal["solid_angle", "uniform"] = "solid_angle",
+    multistart: bool = True,
+    theta_cap: float = ...,
+    beam_mask: float = 3.0,
+    hemisphere: Optional[Literal["front", "back", "both"]] = None,
+    min_value: Optional[float] = None,
+    mask_holder: bool = False,
+    beam_integral: Optional[float] = None,
+    rho: Optional[tuple[float, float]] = None,
+    free_scale: bool = False,
+    interpolation: Literal["pchip", "linear"] = "pchip",
+    adequacy: bool = True,
+    jobs: Optional[int] = None,
+) -> Fit: ...

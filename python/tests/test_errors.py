@@ -1,0 +1,120 @@
+"""Bad input raises the right brtf exception, with the file and line and
+a clear message; nothing crashes the interpreter."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import brtf
+
+
+def test_missing_file(tmp_path):
+    missing = tmp_path / "nope.mpc"
+    with pytest.raises(brtf.MissingFileError) as e:
+        brtf.read(missing)
+    assert isinstance(e.value, FileNotFoundError) and isinstance(e.value, brtf.BrtfError)
+    assert e.value.file == str(missing)
+    assert "No such file" in str(e.value)
+    with pytest.raises(brtf.MissingFileError):
+        brtf.fit([missing], model="metal")
+    with pytest.raises(brtf.MissingFileError):
+        brtf.Material.from_rad(tmp_path / "nope.rad")
+    with pytest.raises(brtf.MissingFileError):
+        brtf.Fit.load(tmp_path)
+    with pytest.raises(brtf.MissingFileError):
+        brtf.read_klems(tmp_path / "nope.xml")
+
+
+def test_malformed_measurement_names_file_and_line(tmp_path):
+    bad = tmp_path / "bad.txt"
+    bad.write_text("#intheta 30\n#inphi 0\n#format: theta phi BSDF\n30 180 2.5\n10 zero 0.3\n")
+    with pytest.raises(brtf.FormatError) as e:
+        brtf.read(bad)
+    assert isinstance(e.value, ValueError)
+    assert e.value.file == str(bad) and e.value.line == 5
+    assert str(e.value).startswith(f"{bad}:5: ")
+    with pytest.raises(brtf.FormatError) as e:
+        brtf.fit(bad, model="metal")
+    assert e.value.line == 5
+
+
+def test_malformed_radiance_and_klems(tmp_path):
+    with pytest.raises(brtf.FormatError) as e:
+        brtf.Material.from_rad("void metal m\n0\n0\n4 0.5 0.5 0.5 0.9\n")
+    assert e.value.line is not None and "metal" in str(e.value)
+    xml = tmp_path / "bad.xml"
+    xml.write_text("<?xml version='1.0'?>\n<WindowElement>\n<Optical>\n")
+    with pytest.raises(brtf.FormatError) as e:
+        brtf.read_klems(xml)
+    assert e.value.file == str(xml)
+    (tmp_path / "fit.json").write_text("{\n  \"schema\": 1,\n oops\n")
+    with pytest.raises(brtf.FormatError) as e:
+        brtf.Fit.load(tmp_path)
+    assert e.value.line == 3
+
+
+def test_wrong_model_name_and_options(alu):
+    with pytest.raises(brtf.ModelError) as e:
+        brtf.fit(alu, model="metl")
+    assert "metl" in str(e.value) and "plastic, metal, trans" in str(e.value)
+    assert isinstance(e.value, ValueError)
+    with pytest.raises(brtf.ModelError, match="unknown material type"):
+        brtf.Material("shiny", rgb=0.5)
+    with pytest.raises(brtf.ModelError, match="residual"):
+        brtf.fit(alu, model="metal", residual="squared")
+    with pytest.raises(brtf.ModelError, match="loss"):
+        brtf.fit(alu, model="metal", loss="tukey")
+    with pytest.raises(brtf.ModelError, match="spec is 1.5"):
+        brtf.Material("metal", rgb=0.5, spec=1.5, roughness=0.1)
+    with pytest.raises(brtf.ModelError, match="trans= is needed"):
+        brtf.Material("trans", rgb=0.5, spec=0.0, roughness=0.1)
+    with pytest.raises(brtf.ModelError, match="--source-omega"):
+        brtf.Material("metal", rgb=0.5, source_omega=-1)
+    m = brtf.Material("metal", rgb=0.5, spec=0.5, roughness=0.1)
+    with pytest.raises(brtf.ModelError, match="theta-in"):
+        m.eval(90, 0, 30, 180)
+    with pytest.raises(ValueError):  # numpy: shapes that do not broadcast
+        m.eval(30, 0, np.zeros(3), np.zeros(4))
+    with pytest.raises(brtf.ModelError, match="klems"):
+        brtf.fit(alu, model="metal").export("/tmp/never", klems="eighth")
+
+
+def test_fit_error_is_a_fit_error(tmp_path):
+    # Every value zero: nothing to fit.
+    flat = tmp_path / "zero.txt"
+    rows = "".join(f"{t} {p} 0\n" for t in range(5, 80, 5) for p in range(0, 360, 30))
+    flat.write_text("#intheta 30\n#inphi 0\n#format: theta phi BSDF\n" + rows)
+    with pytest.raises(brtf.FitError) as e:
+        brtf.fit(flat, model="metal")
+    assert isinstance(e.value, RuntimeError)
+    assert "zero" in str(e.value)
+
+
+def test_bad_input_does_not_crash_the_interpreter(tmp_path):
+    # Garbage of every kind, in a child interpreter: it must exit normally.
+    code = """
+import brtf, numpy as np, os, sys
+tmp = sys.argv[1]
+junk = [b"", b"\\x00\\xff" * 100, b"#intheta nan\\n", b"<?xml?><a>", b"#format: theta phi BSDF\\n1e400 0 1\\n"]
+caught = 0
+for i, data in enumerate(junk):
+    p = os.path.join(tmp, f"j{i}.txt")
+    open(p, "wb").write(data)
+    for call in (lambda: brtf.read(p), lambda: brtf.read_klems(p), lambda: brtf.fit(p),
+                 lambda: brtf.Material.from_rad(data.decode("latin-1") + "\\n")):
+        try:
+            call()
+        except brtf.BrtfError:
+            caught += 1
+m = brtf.Material("metal", rgb=0.5, spec=0.5, roughness=0.1)
+v = m.eval(30, 0, np.array([np.nan, np.inf, -1e300, 720.0]), 0)
+print("caught", caught, np.isnan(v).any())
+"""
+    done = subprocess.run([sys.executable, "-c", code, str(tmp_path)], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.startswith("caught ")
+    assert int(done.stdout.split()[1]) >= 15
