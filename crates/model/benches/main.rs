@@ -1,7 +1,9 @@
 //! brtf-model benchmarks: BSDF evaluations per second per type, gradient
 //! cost, and ρ_dh time per incidence. Seeded inputs, one bench binary.
 
-use brtf_model::{Bsdf, EvalOptions, Gradient, Material, MaterialKind, albedo, direction};
+use brtf_model::{
+    Bsdf, Directions, EvalOptions, Gradient, Material, MaterialKind, RgbBatch, albedo, direction,
+};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::DVec3;
 use std::hint::black_box;
@@ -77,6 +79,31 @@ fn bench_eval(c: &mut Criterion) {
     group.finish();
 }
 
+/// The same 4096 pairs through [`Bsdf::eval_batch`] (structure of arrays,
+/// vectorised kernel); the rate is pairs per second on one core.
+fn bench_eval_batch(c: &mut Criterion) {
+    let pairs = direction_pairs();
+    let lights: Vec<DVec3> = pairs.iter().map(|p| p.0).collect();
+    let views: Vec<DVec3> = pairs.iter().map(|p| p.1).collect();
+    let (light, view) = (
+        Directions::from_vectors(&lights),
+        Directions::from_vectors(&views),
+    );
+    let mut out = RgbBatch::default();
+    let mut group = c.benchmark_group("eval_batch");
+    group.throughput(Throughput::Elements(PAIRS as u64));
+    for kind in MaterialKind::ALL {
+        let bsdf = Bsdf::new(&material(kind), &EvalOptions::default());
+        group.bench_function(kind.name(), |b| {
+            b.iter(|| {
+                bsdf.eval_batch(black_box(&light), black_box(&view), &mut out);
+                out.g[PAIRS / 2]
+            })
+        });
+    }
+    group.finish();
+}
+
 fn bench_albedo(c: &mut Criterion) {
     let mut group = c.benchmark_group("albedo");
     for (kind, theta) in [
@@ -95,5 +122,5 @@ fn bench_albedo(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench_eval, bench_albedo);
+criterion_group!(benches, bench_eval, bench_eval_batch, bench_albedo);
 criterion_main!(benches);

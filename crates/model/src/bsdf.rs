@@ -213,6 +213,39 @@ impl Bsdf {
         (self.frame_u, self.frame_v)
     }
 
+    /// The specularity argument (before any Fresnel estimate).
+    pub(crate) fn spec_arg(&self) -> f64 {
+        self.spec
+    }
+
+    /// The transmissivity argument (0 for the opaque types).
+    pub(crate) fn trans_arg(&self) -> f64 {
+        self.trans
+    }
+
+    /// The transmitted-specular fraction (0 for the opaque types).
+    pub(crate) fn tspec_arg(&self) -> f64 {
+        self.tspec
+    }
+
+    /// The roughness-0 Fresnel estimate applies.
+    pub(crate) fn has_fresnel(&self) -> bool {
+        self.fresnel
+    }
+
+    /// 1/(α² + widening) of the reflected lobe along û and v̂.
+    pub(crate) fn reflect_inv_width(&self) -> (f64, f64) {
+        self.reflect_inv_width
+    }
+
+    /// α² + ω/π of the transmitted lobe along û and v̂.
+    pub(crate) fn transmit_width(&self) -> (f64, f64) {
+        (
+            self.alpha2_u + self.transmit_widening,
+            self.alpha2_v + self.transmit_widening,
+        )
+    }
+
     /// Rtrace's Fresnel estimate `exp(-5.85 c) - K`.
     pub fn fresnel_estimate(&self, cosine: f64) -> f64 {
         (-5.85 * cosine).exp() - self.options.fresnel_k

@@ -22,9 +22,15 @@
 //!
 //! See `docs/models.md` for every type and variant.
 //!
-//! This crate does no I/O and depends on glam only.
+//! [`Bsdf::eval_batch`] evaluates many direction pairs at once over
+//! structure-of-arrays inputs ([`Directions`], [`RgbBatch`]) with a
+//! vectorised kernel, to the same values.
+//!
+//! This crate does no I/O and depends on glam and pulp (run-time SIMD
+//! dispatch for the batch kernel) only.
 
 mod albedo;
+mod batch;
 mod bsdf;
 pub mod colour;
 mod kind;
@@ -33,6 +39,7 @@ mod options;
 pub mod rng;
 
 pub use albedo::{Albedo, albedo, gauss_legendre_rule};
+pub use batch::{Directions, RgbBatch, exp_lane};
 pub use bsdf::{Bsdf, Geometry, Gradient, Rgb, ViewSplit};
 pub use kind::{MaterialKind, Variant};
 pub use material::{FTINY, MAX_ARGS, Material, ModelError, check_args};
