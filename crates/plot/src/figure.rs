@@ -10,9 +10,10 @@
 //!   `sans-serif` family before anything is drawn ([`register_fonts`]), so
 //!   charts render on a machine without fontconfig or any font installed.
 //!   SVG files keep text as `<text>` elements for the viewer's own fonts.
-//! * **Rasters.** Dense images (the residual maps) are drawn pixel by pixel
-//!   into PNGs, and embedded once as a base64 PNG `<image>` into SVGs (an
-//!   SVG rectangle per pixel would be megabytes): the chart draws a
+//! * **Rasters.** Dense images (the residual maps) are copied into the
+//!   PNG's pixel buffer in one go (one plotters call, not one per pixel),
+//!   and embedded once as a base64 PNG `<image>` into SVGs (an SVG
+//!   rectangle per pixel would be megabytes): the chart draws a
 //!   placeholder rectangle in a reserved colour, which is then replaced.
 
 use crate::error::PlotError;
@@ -87,7 +88,8 @@ impl Canvas {
     }
 
     /// Draws `raster` with its upper-left corner at backend pixel
-    /// `upper_left` (on the root area).
+    /// `upper_left` (on the root area). Draw it before anything else in
+    /// its rectangle: it is blended with white, not with what is there.
     pub fn place<DB: DrawingBackend>(
         &self,
         root: &Area<DB>,
@@ -96,16 +98,23 @@ impl Canvas {
     ) -> Result<(), String> {
         match self.mode {
             Mode::Png => {
-                for (k, px) in raster.rgba.chunks_exact(4).enumerate() {
-                    if px[3] == 0 {
-                        continue;
+                // One copy into the pixel buffer (not a plotters call per
+                // pixel). The area under a raster is still the white of
+                // the background, so transparent pixels become white.
+                let mut rgb = Vec::with_capacity(raster.rgba.len() / 4 * 3);
+                for px in raster.rgba.chunks_exact(4) {
+                    let a = u32::from(px[3]);
+                    for &c in &px[..3] {
+                        rgb.push(((u32::from(c) * a + 255 * (255 - a) + 127) / 255) as u8);
                     }
-                    let x = upper_left.0 + (k as u32 % raster.width) as i32;
-                    let y = upper_left.1 + (k as u32 / raster.width) as i32;
-                    let colour = RGBAColor(px[0], px[1], px[2], px[3] as f64 / 255.0);
-                    root.draw_pixel((x, y), &colour).msg()?;
                 }
-                Ok(())
+                let image = BitMapElement::with_owned_buffer(
+                    upper_left,
+                    (raster.width, raster.height),
+                    rgb,
+                )
+                .ok_or("raster size does not match its pixels")?;
+                root.draw(&image).msg()
             }
             Mode::Svg => {
                 let mut pending = self.pending.borrow_mut();

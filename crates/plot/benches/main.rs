@@ -1,0 +1,91 @@
+//! brtf-plot benchmarks on the real 127 039-point pgII scan
+//! `golden_paper.txt` (read from `../shared/data`, never copied into the
+//! repository), fitted once with `metal --gray` as `brtf fit` does by
+//! default:
+//!
+//! * `plots/write_plots`: everything `brtf fit` adds for its plots (the
+//!   file read again and rebuilt with the fit's recipe, every SVG and PNG,
+//!   `report.html`), into a temporary folder. The target of issue 18 is
+//!   40 ms.
+//! * `plots/load`: only the rebuild of the data ([`brtf_plot::prepare::load`]).
+//! * `plots/map_png`, `plots/map_svg`: the residual map alone, on data
+//!   already loaded (its nearest-sample grid made afresh each time).
+
+use brtf_fit::{FitConfig, FitSetOptions, NoProgress, Recipe};
+use brtf_model::MaterialKind;
+use brtf_plot::charts::map::MapChart;
+use brtf_plot::{PlotOptions, figure, prepare};
+use criterion::{Criterion, criterion_group, criterion_main};
+use std::hint::black_box;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+fn golden_path() -> PathBuf {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/data/rgl-epfl-pgII-raw/golden_paper.txt");
+    assert!(
+        path.is_file(),
+        "{} is missing: the benchmark needs the shared data folder beside the repository",
+        path.display()
+    );
+    path
+}
+
+/// The fit of `brtf fit golden_paper.txt --model metal --gray` (made once).
+fn fitted() -> &'static brtf_fit::FitResult {
+    static FIT: OnceLock<brtf_fit::FitResult> = OnceLock::new();
+    FIT.get_or_init(|| {
+        let kind = MaterialKind::Metal;
+        let mut config = FitConfig::new(kind);
+        config.gray = true;
+        let options = FitSetOptions {
+            name: "golden_paper".into(),
+            config,
+            recipe: Recipe::for_kind(kind),
+            known_reflectance: None,
+            interpolation: Default::default(),
+            command_line: vec!["bench".into()],
+            adequacy: true,
+            klems: Default::default(),
+        };
+        brtf_fit::fit_set(&[golden_path()], &options, &NoProgress).expect("the scan fits")
+    })
+}
+
+fn plots(c: &mut Criterion) {
+    let result = fitted();
+    let options = PlotOptions::default();
+    let out = tempfile::tempdir().unwrap();
+    let mut group = c.benchmark_group("plots");
+    group.sample_size(20);
+    group.bench_function("write_plots", |b| {
+        b.iter(|| brtf_plot::write_plots(out.path(), black_box(result), &options).unwrap())
+    });
+    group.bench_function("load", |b| {
+        b.iter(|| prepare::load(result, 0, "t".into(), out.path(), &[]).unwrap())
+    });
+    group.bench_function("map_png", |b| {
+        b.iter_batched(
+            || prepare::load(result, 0, "t".into(), out.path(), &[]).unwrap(),
+            |inc| {
+                let map = MapChart::new(&inc, "map".into(), 2.0, 0.1);
+                figure::render_png(&map).unwrap()
+            },
+            criterion::BatchSize::LargeInput,
+        )
+    });
+    group.bench_function("map_svg", |b| {
+        b.iter_batched(
+            || prepare::load(result, 0, "t".into(), out.path(), &[]).unwrap(),
+            |inc| {
+                let map = MapChart::new(&inc, "map".into(), 2.0, 0.1);
+                figure::render_svg(&map).unwrap()
+            },
+            criterion::BatchSize::LargeInput,
+        )
+    });
+    group.finish();
+}
+
+criterion_group!(benches, plots);
+criterion_main!(benches);
