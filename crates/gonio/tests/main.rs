@@ -12,6 +12,7 @@ mod integral;
 mod klems;
 mod measurement;
 mod read;
+mod read_paths;
 mod robustness;
 mod select;
 mod solid_angle;

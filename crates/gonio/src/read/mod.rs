@@ -158,7 +158,10 @@ pub(crate) fn check_text<'a>(bytes: &'a [u8], name: &Path) -> Result<Cow<'a, str
     if bytes.iter().all(u8::is_ascii_whitespace) {
         return Err(parse_error(name, 1, ParseErrorKind::Empty));
     }
-    if let Some(offset) = bytes.iter().position(|&b| b == 0) {
+    // `contains` scans with memchr, several times faster than `position`.
+    if bytes.contains(&0)
+        && let Some(offset) = bytes.iter().position(|&b| b == 0)
+    {
         let kind = ParseErrorKind::Binary {
             what: "NUL byte",
             offset,

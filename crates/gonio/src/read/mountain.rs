@@ -10,9 +10,13 @@
 
 use std::path::Path;
 
-use super::{HeaderAngle, Row, numbered_lines, parse_error, resolve_incidence};
+use super::number::parse_prefix;
+use super::text::Lines;
+use super::{HeaderAngle, Row, check_direction, parse_error, resolve_incidence};
 use crate::error::{ParseErrorKind, ReadError};
-use crate::measurement::{Channels, Measurement, Quantity, Sample, SourceFormat};
+use crate::measurement::{
+    Channels, Measurement, Quantity, SENTINEL_THRESHOLD, Sample, SourceFormat,
+};
 
 const LAYOUT_Y: &str = "theta phi value";
 const LAYOUT_XYZ: &str = "theta phi X Y Z";
@@ -93,26 +97,13 @@ pub(crate) fn parse(text: &str, name: &Path) -> Result<Measurement, ReadError> {
     let mut first_data_line: Option<usize> = None;
     let mut last_line = 1;
 
-    for (line_no, line) in numbered_lines(text) {
-        last_line = line_no;
-        let is_header = line.trim_ascii_start().starts_with('#');
-        if let Some(first) = first_data_line {
-            if is_header {
-                let kind = ParseErrorKind::HeaderAfterData {
-                    first_data_line: first,
-                };
-                return Err(parse_error(name, line_no, kind));
-            }
-            let sample = match channels {
-                Channels::Y => parse_row_y(line),
-                Channels::Xyz => parse_row_xyz(line),
-            }
-            .map_err(|kind| parse_error(name, line_no, kind))?;
-            samples.push(sample);
+    let mut lines = Lines::new(text);
+    for (line_no, line) in lines.by_ref() {
+        if line.trim_ascii().is_empty() {
             continue;
         }
-
-        if is_header {
+        last_line = line_no;
+        if line.trim_ascii_start().starts_with('#') {
             header.push(line.to_owned());
             let Some((key, rest)) = split_key(line) else {
                 continue;
@@ -176,14 +167,21 @@ pub(crate) fn parse(text: &str, name: &Path) -> Result<Measurement, ReadError> {
         if quantity.is_none() {
             return Err(parse_error(name, line_no, ParseErrorKind::MissingFormat));
         }
-        let sample = match channels {
-            Channels::Y => parse_row_y(line),
-            Channels::Xyz => parse_row_xyz(line),
-        }
-        .map_err(|kind| parse_error(name, line_no, kind))?;
+        let sample = parse_row(line, channels).map_err(|kind| parse_error(name, line_no, kind))?;
         // Reserve once the row length is known: ~1 sample per 30 bytes.
         samples.reserve(text.len() / line.len().max(24));
         samples.push(sample);
+        break;
+    }
+    if let Some(first) = first_data_line {
+        let rest = DataRows {
+            text,
+            pos: lines.position(),
+            lines_before: first,
+            first_data_line: first,
+            channels,
+        };
+        rest.read_into(&mut samples, name)?;
     }
 
     let Some(first_data_line) = first_data_line else {
@@ -252,6 +250,133 @@ fn set_angle(
         *slot = Some(HeaderAngle { value, line });
     }
     Ok(())
+}
+
+/// The data rows after the first: a byte loop for plain rows, the general
+/// line-by-line rules for anything else.
+struct DataRows<'a> {
+    text: &'a str,
+    /// Where the unread rows start (the start of a line).
+    pos: usize,
+    /// Lines before `pos`.
+    lines_before: usize,
+    first_data_line: usize,
+    channels: Channels,
+}
+
+impl DataRows<'_> {
+    /// Reads every remaining row into `samples`. Plain rows (numbers that
+    /// take the exact fast path, separated by spaces or tabs, ended by LF,
+    /// CRLF or the end of the text) are read by [`plain_rows`]; a row it
+    /// does not take (a blank line, a lone CR, a header line, an unusual
+    /// number, an error) goes through the same rules as the first row, so
+    /// results and errors are the same as reading every line that way.
+    fn read_into(mut self, samples: &mut Vec<Sample>, name: &Path) -> Result<(), ReadError> {
+        let bytes = self.text.as_bytes();
+        loop {
+            let (pos, rows) = match self.channels {
+                Channels::Y => plain_rows::<1>(bytes, self.pos, samples),
+                Channels::Xyz => plain_rows::<3>(bytes, self.pos, samples),
+            };
+            self.pos = pos;
+            self.lines_before += rows;
+            let mut lines = Lines::resume(self.text, self.pos, self.lines_before);
+            let Some((line_no, line)) = lines.next() else {
+                return Ok(());
+            };
+            self.pos = lines.position();
+            self.lines_before = line_no;
+            if line.trim_ascii().is_empty() {
+                continue;
+            }
+            if line.trim_ascii_start().starts_with('#') {
+                let kind = ParseErrorKind::HeaderAfterData {
+                    first_data_line: self.first_data_line,
+                };
+                return Err(parse_error(name, line_no, kind));
+            }
+            let sample =
+                parse_row(line, self.channels).map_err(|kind| parse_error(name, line_no, kind))?;
+            samples.push(sample);
+        }
+    }
+}
+
+/// Reads plain rows of θ, φ and `VALUES` values from `bytes[pos..]` until
+/// one is not plain; returns where that row starts and how many rows were
+/// read. A plain row gives the same sample as [`parse_row`]: the numbers
+/// take the exact fast path ([`parse_prefix`]), which the general path
+/// also tries first.
+fn plain_rows<const VALUES: usize>(
+    bytes: &[u8],
+    mut pos: usize,
+    samples: &mut Vec<Sample>,
+) -> (usize, usize) {
+    let mut rows = 0;
+    while pos < bytes.len() {
+        let Some((sample, next)) = plain_row::<VALUES>(bytes, pos) else {
+            break;
+        };
+        samples.push(sample);
+        pos = next;
+        rows += 1;
+    }
+    (pos, rows)
+}
+
+/// One plain row starting at `pos`: the sample and where the next line
+/// starts, or `None` when the row is not plain.
+#[inline]
+fn plain_row<const VALUES: usize>(bytes: &[u8], mut pos: usize) -> Option<(Sample, usize)> {
+    let blank = |b: u8| b == b' ' || b == b'\t';
+    let mut fields = [0.0; 5];
+    for (k, field) in fields.iter_mut().take(2 + VALUES).enumerate() {
+        // Leading blanks, and at least one blank between fields.
+        let start = pos;
+        while pos < bytes.len() && blank(bytes[pos]) {
+            pos += 1;
+        }
+        if k > 0 && pos == start {
+            return None;
+        }
+        let (value, used) = parse_prefix(bytes.get(pos..)?)?;
+        *field = value;
+        pos += used;
+    }
+    while pos < bytes.len() && blank(bytes[pos]) {
+        pos += 1;
+    }
+    let next = match bytes.get(pos) {
+        None => pos,
+        Some(b'\n') => pos + 1,
+        Some(b'\r') if bytes.get(pos + 1) == Some(&b'\n') => pos + 2,
+        Some(_) => return None,
+    };
+    let (theta, phi) = check_direction(fields[0], fields[1]).ok()?;
+    let value = |v: f64| {
+        if v.abs() >= SENTINEL_THRESHOLD {
+            f64::NAN
+        } else {
+            v
+        }
+    };
+    let sample = if VALUES == 1 {
+        Sample::luminance(theta, phi, value(fields[2]))
+    } else {
+        Sample::new(
+            theta,
+            phi,
+            [value(fields[2]), value(fields[3]), value(fields[4])],
+        )
+    };
+    Some((sample, next))
+}
+
+fn parse_row(line: &str, channels: Channels) -> Result<Sample, ParseErrorKind> {
+    match channels {
+        Channels::Y => parse_row_y(line),
+        Channels::Xyz => parse_row_xyz(line),
+    }
 }
 
 fn parse_row_y(line: &str) -> Result<Sample, ParseErrorKind> {

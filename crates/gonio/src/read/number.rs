@@ -27,7 +27,7 @@ pub(crate) fn parse_f64(text: &str) -> Result<f64, std::num::ParseFloatError> {
 /// Clinger's fast path on the longest number-like prefix of `bytes`:
 /// `Some((value, bytes used))`, or `None` when the fast path does not apply
 /// (the caller then falls back to `str::parse`). The value is always finite.
-#[inline]
+#[inline(always)]
 pub(crate) fn parse_prefix(bytes: &[u8]) -> Option<(f64, usize)> {
     let mut i = 0;
     let negative = match bytes.first()? {
@@ -44,34 +44,17 @@ pub(crate) fn parse_prefix(bytes: &[u8]) -> Option<(f64, usize)> {
     // Digits are accumulated without per-digit checks (wrapping on
     // overflow); more than 19 digits in all, leading zeros included, falls
     // back to the standard parser before the mantissa is used.
-    let mut mantissa: u64 = 0;
-    let int_start = i;
-    while let Some(&b) = bytes.get(i) {
-        let digit = b.wrapping_sub(b'0');
-        if digit > 9 {
-            break;
-        }
-        mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(digit));
-        i += 1;
-    }
-    let mut digits = i - int_start;
+    let (mut mantissa, int_digits) = digits(bytes, &mut i, 0);
+    let mut digits_total = int_digits;
     let mut exponent: i32 = 0;
     if bytes.get(i) == Some(&b'.') {
         i += 1;
-        let frac_start = i;
-        while let Some(&b) = bytes.get(i) {
-            let digit = b.wrapping_sub(b'0');
-            if digit > 9 {
-                break;
-            }
-            mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(digit));
-            i += 1;
-        }
-        let frac_digits = i - frac_start;
-        digits += frac_digits;
+        let (m, frac_digits) = digits(bytes, &mut i, mantissa);
+        mantissa = m;
+        digits_total += frac_digits;
         exponent = -i32::try_from(frac_digits).ok()?;
     }
-    if digits == 0 || digits > 19 {
+    if digits_total == 0 || digits_total > 19 {
         return None;
     }
     if let Some(&(b'e' | b'E')) = bytes.get(i) {
@@ -114,6 +97,71 @@ pub(crate) fn parse_prefix(bytes: &[u8]) -> Option<(f64, usize)> {
         m / *POW10.get(usize::try_from(-exponent).ok()?)?
     };
     Some((if negative { -magnitude } else { magnitude }, i))
+}
+
+/// Reads the run of ASCII digits at `bytes[*i..]`, appending them to
+/// `mantissa` (wrapping on overflow); returns the new mantissa and the
+/// number of digits, and moves `*i` past them. Eight bytes at a time
+/// where the text has them (SWAR: one 64-bit load, one digit test, three
+/// multiplications), byte by byte near the end.
+#[inline(always)]
+fn digits(bytes: &[u8], i: &mut usize, mut mantissa: u64) -> (u64, usize) {
+    let start = *i;
+    while let Some(chunk) = bytes.get(*i..*i + 8) {
+        let word = u64::from_le_bytes(chunk.try_into().expect("eight bytes"));
+        // Bit 7 of each byte: set where the byte is not a digit. Exact up
+        // to and including the first non-digit, which is all that is used.
+        let below = word.wrapping_sub(0x3030_3030_3030_3030);
+        let above = word.wrapping_add(0x4646_4646_4646_4646);
+        let non_digits = (below | above) & 0x8080_8080_8080_8080;
+        let count = (non_digits.trailing_zeros() / 8) as usize;
+        if count > 0 {
+            // The `count` digits (first byte lowest) moved to the top, the
+            // bytes below them zero: leading zeros of an 8-digit number.
+            let aligned = below << (8 * (8 - count));
+            mantissa = mantissa
+                .wrapping_mul(POW10_U64[count])
+                .wrapping_add(eight_digits(aligned));
+        }
+        *i += count;
+        if count < 8 {
+            return (mantissa, *i - start);
+        }
+    }
+    while let Some(&b) = bytes.get(*i) {
+        let digit = b.wrapping_sub(b'0');
+        if digit > 9 {
+            break;
+        }
+        mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(digit));
+        *i += 1;
+    }
+    (mantissa, *i - start)
+}
+
+/// Powers of ten up to 10⁸ as integers.
+const POW10_U64: [u64; 9] = [
+    1,
+    10,
+    100,
+    1_000,
+    10_000,
+    100_000,
+    1_000_000,
+    10_000_000,
+    100_000_000,
+];
+
+/// The value of eight decimal digits, one per byte (each 0 to 9), the
+/// first (most significant) in the lowest byte.
+#[inline(always)]
+fn eight_digits(digits: u64) -> u64 {
+    // Pairs, then quadruples, then the whole (each step halves the count).
+    let pairs = digits.wrapping_mul(10).wrapping_add(digits >> 8);
+    const MASK: u64 = 0x0000_00FF_0000_00FF;
+    let high = (pairs & MASK).wrapping_mul(100 + (1_000_000 << 32));
+    let low = ((pairs >> 16) & MASK).wrapping_mul(1 + (10_000 << 32));
+    (high.wrapping_add(low) >> 32) & 0xFFFF_FFFF
 }
 
 #[cfg(test)]
@@ -185,6 +233,28 @@ mod tests {
             let ours = parse_f64(&text).map(f64::to_bits).ok();
             let std = text.parse::<f64>().map(f64::to_bits).ok();
             proptest::prop_assert_eq!(ours, std, "{}", text);
+        }
+
+        #[test]
+        fn prefixes_inside_rows_agree_with_std(
+            sign in "[+-]?",
+            int in "[0-9]{0,22}",
+            frac in proptest::option::of("[0-9]{0,22}"),
+            exp in proptest::option::of("[eE][+-]?[0-9]{1,4}"),
+            tail in "[ \t\r\n#a-z.0-9]{0,12}",
+        ) {
+            // Followed by more text, as in a file: the 8-byte digit path.
+            let text = format!(
+                "{sign}{int}{}{}",
+                frac.map(|f| format!(".{f}")).unwrap_or_default(),
+                exp.unwrap_or_default()
+            );
+            let row = format!("{text}\t{tail}");
+            if let Some((value, used)) = parse_prefix(row.as_bytes()) {
+                let std = row[..used].parse::<f64>().map(f64::to_bits).ok();
+                proptest::prop_assert_eq!(Some(value.to_bits()), std, "{:?}", row);
+                proptest::prop_assert!(used <= text.len(), "{:?}", row);
+            }
         }
 
         #[test]

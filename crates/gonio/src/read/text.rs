@@ -79,12 +79,23 @@ pub(crate) struct Lines<'a> {
 
 impl<'a> Lines<'a> {
     pub(crate) fn new(text: &'a str) -> Self {
+        Self::resume(text, 0, 0)
+    }
+
+    /// The lines of `text` from byte `pos` (the start of a line), the
+    /// first numbered `lines_before + 1`.
+    pub(crate) fn resume(text: &'a str, pos: usize, lines_before: usize) -> Self {
         Self {
             text,
-            pos: 0,
-            number: 0,
+            pos,
+            number: lines_before,
             next_line_feed: None,
         }
+    }
+
+    /// The byte offset where the next line starts.
+    pub(crate) fn position(&self) -> usize {
+        self.pos
     }
 }
 
