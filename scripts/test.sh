@@ -44,4 +44,27 @@ set -e
 # binary's, often "0 passed").
 awk '/^test result:/ { for (i = 1; i <= NF; i++) { if ($(i+1) ~ /^passed/) p += $i; if ($(i+1) ~ /^failed/) f += $i } }
      END { printf "tests: %d passed, %d failed\n", p, f }' target/test-output.log
+
+# --- Python package (python/, crates/py; docs/python.md) -------------------
+# Builds the `brtf` wheel (maturin, release build of crates/py) into .venv,
+# then runs its pytest suite, which compares it with the brtf binary that
+# `cargo test` just built, and the worked example of docs/python.md.
+# A failure here fails the script.
+if ! .venv/bin/python -c "import maturin, pytest, matplotlib" 2>/dev/null; then
+    echo "== installing maturin, pytest and matplotlib into .venv"
+    .venv/bin/pip install --quiet --disable-pip-version-check "maturin>=1.9,<2" pytest matplotlib
+fi
+echo "== pip install ./python (maturin, release build)"
+python_status=0
+PATH="$PWD/.venv/bin:$PATH" .venv/bin/pip install --quiet --disable-pip-version-check \
+    --no-build-isolation --force-reinstall --no-deps ./python || python_status=$?
+if [ "$python_status" -eq 0 ]; then
+    echo "== pytest python/tests"
+    BRTF_BIN="$PWD/target/debug/brtf" .venv/bin/python -m pytest -q -p no:cacheprovider python/tests \
+        || python_status=$?
+    echo "== docs/python.md example"
+    .venv/bin/python python/examples/golden_paper.py --out target/python-example >/dev/null \
+        || python_status=$?
+fi
+[ "$status" -ne 0 ] || status=$python_status
 exit "$status"

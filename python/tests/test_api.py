@@ -51,6 +51,8 @@ def test_read_klems(klems_fabric):
     assert front[0].path is None and len(front[0]) == 290  # reflection + transmission patches
     with pytest.raises(brtf.FitError, match="Klems patch"):
         brtf.fit(front[0])
+    with pytest.raises(brtf.FitError, match="brtf fit FILE.xml"):
+        brtf.fit(klems_fabric)
 
 
 def test_material_construction_and_rad_round_trip():

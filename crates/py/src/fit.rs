@@ -68,6 +68,28 @@ fn input_paths(inputs: &Bound<'_, PyAny>) -> PyResult<Vec<PathBuf>> {
     Ok(paths)
 }
 
+/// Klems BSDF XML needs `brtf fit`'s Klems settings (patch averaging,
+/// per side), which this package does not map yet: refused, not fitted
+/// as point samples.
+fn refuse_klems(path: &Path) -> PyResult<()> {
+    use std::io::Read;
+    let mut head = Vec::with_capacity(4096);
+    let opened = std::fs::File::open(path).and_then(|f| f.take(4096).read_to_end(&mut head));
+    if opened.is_ok() && brtf_gonio::is_xml(&head) {
+        return Err(errors::error(
+            Class::Fit,
+            format!(
+                "{}: Klems BSDF XML is fitted with `brtf fit FILE.xml` (per side, patch averages); \
+                 brtf.fit does not fit it yet",
+                path.display()
+            ),
+            Some(path.display().to_string()),
+            None,
+        ));
+    }
+    Ok(())
+}
+
 /// The keyword arguments of `brtf.fit`, as `brtf fit`'s options.
 pub struct FitKwargs {
     pub model: String,
@@ -224,6 +246,9 @@ pub fn run_fit(
     jobs: Option<usize>,
 ) -> PyResult<Fit> {
     let paths = input_paths(inputs)?;
+    for path in &paths {
+        refuse_klems(path)?;
+    }
     let name = match &kwargs.name {
         Some(name) => name.clone(),
         None => {
