@@ -22,7 +22,7 @@ use glam::DVec3;
 
 use crate::rng::Rng;
 use crate::sampling::cosine_hemisphere;
-use crate::scene::{Hit, RAY_EPSILON, Ray, Scene};
+use crate::scene::{Hit, PreparedSource, RAY_EPSILON, Ray, Scene};
 
 use crate::sampling::{ReflectionLobe, TransmissionLobe};
 
@@ -131,12 +131,15 @@ enum Kind {
 }
 
 /// A ray tracer over one scene.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct Tracer<'a> {
     /// The scene.
     pub scene: &'a Scene,
     /// Sample counts.
     pub settings: Settings,
+    /// The scene's sources with their per-source sampling constants
+    /// worked out once (not per shadow ray).
+    sources: Vec<PreparedSource>,
 }
 
 #[inline]
@@ -149,7 +152,11 @@ fn add_scaled(acc: &mut Rgb, w: Rgb, x: Rgb) {
 impl<'a> Tracer<'a> {
     /// A tracer for `scene`.
     pub fn new(scene: &'a Scene, settings: Settings) -> Tracer<'a> {
-        Tracer { scene, settings }
+        Tracer {
+            scene,
+            settings,
+            sources: scene.sources.iter().map(PreparedSource::new).collect(),
+        }
     }
 
     /// Radiance arriving along a camera ray (towards `-ray.dir`).
@@ -250,7 +257,7 @@ impl<'a> Tracer<'a> {
 
         // Direct term: every source, sampled over its solid angle.
         let n_src = if first { s.source_samples.max(1) } else { 1 };
-        for source in &self.scene.sources {
+        for source in &self.sources {
             let mut sum = [0.0; 3];
             for _ in 0..n_src {
                 let u = given_u.take().unwrap_or_else(|| rng.uniform2());
@@ -281,6 +288,19 @@ impl<'a> Tracer<'a> {
             }
         }
 
+        // The lobes are only needed for delta, specular or diffuse rays
+        // (not for direct light alone, the common case).
+        let n_spec = if first {
+            s.specular_samples
+        } else {
+            s.specular_samples.min(1)
+        };
+        let delta_rays = shader.has_delta() && depth < s.max_depth.max(1);
+        let specular_rays = depth < s.max_depth && n_spec > 0;
+        let diffuse_rays = diffuse_allowed && s.diffuse_samples > 0;
+        if !(delta_rays || specular_rays || diffuse_rays) {
+            return out;
+        }
         let lobes = shader.lobes(v, degenerate);
         // Roughness 0: the mirror and straight-through rays.
         if let Some((mirror, through)) = lobes.delta
@@ -306,12 +326,7 @@ impl<'a> Tracer<'a> {
         }
 
         // Rough specular lobes.
-        let n_spec = if first {
-            s.specular_samples
-        } else {
-            s.specular_samples.min(1)
-        };
-        if depth < s.max_depth && n_spec > 0 {
+        if specular_rays {
             let reflect = lobes.reflect.map(SpecularLobe::Reflect);
             let transmit = lobes.transmit.map(SpecularLobe::Transmit);
             for lobe in [reflect, transmit].into_iter().flatten() {
@@ -349,7 +364,7 @@ impl<'a> Tracer<'a> {
         }
 
         // One-bounce diffuse.
-        if diffuse_allowed && s.diffuse_samples > 0 {
+        if diffuse_rays {
             let n_diff = if first { s.diffuse_samples } else { 1 };
             for (present, side) in [(lobes.diffuse_reflect, 1.0), (lobes.diffuse_transmit, -1.0)] {
                 if !present {

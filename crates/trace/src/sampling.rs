@@ -33,10 +33,15 @@ use std::f64::consts::PI;
 /// Unit direction from polar cosine and azimuth in a frame (`e1`, `e2`, `axis`).
 #[inline]
 fn around(axis: DVec3, cos_t: f64, phi: f64) -> DVec3 {
+    around_in(&crate::frame::Frame::from_z(axis), cos_t, phi)
+}
+
+/// [`around`] with the frame around the axis already made.
+#[inline]
+fn around_in(frame: &crate::frame::Frame, cos_t: f64, phi: f64) -> DVec3 {
     let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
     let (sp, cp) = phi.sin_cos();
-    let f = crate::frame::Frame::from_z(axis);
-    f.to_world(DVec3::new(sin_t * cp, sin_t * sp, cos_t))
+    frame.to_world(DVec3::new(sin_t * cp, sin_t * sp, cos_t))
 }
 
 /// `1 − cos a` without cancellation for small angles.
@@ -79,6 +84,19 @@ pub fn cosine_hemisphere_pdf(d: DVec3, side: f64) -> f64 {
 pub fn uniform_cone(axis: DVec3, half_angle: f64, u: [f64; 2]) -> DVec3 {
     let cos_t = 1.0 - u[0] * one_minus_cos(half_angle);
     around(axis, cos_t, 2.0 * PI * u[1])
+}
+
+/// [`uniform_cone`] with what depends on the cone alone worked out once:
+/// `frame = Frame::from_z(axis)` and `one_minus_cos(half_angle)`. Gives
+/// the same directions, bit for bit.
+#[inline]
+pub(crate) fn uniform_cone_in(
+    frame: &crate::frame::Frame,
+    one_minus_cos_half: f64,
+    u: [f64; 2],
+) -> DVec3 {
+    let cos_t = 1.0 - u[0] * one_minus_cos_half;
+    around_in(frame, cos_t, 2.0 * PI * u[1])
 }
 
 /// Density of [`uniform_cone`].

@@ -13,7 +13,8 @@
 use brtf_model::Rgb;
 use glam::DVec3;
 
-use crate::sampling::{cap_solid_angle, one_minus_cos, uniform_cone};
+use crate::frame::Frame;
+use crate::sampling::{cap_solid_angle, one_minus_cos, uniform_cone, uniform_cone_in};
 use crate::shader::Shader;
 
 /// A ray: origin and unit direction.
@@ -219,6 +220,52 @@ impl Source {
     }
 }
 
+/// A source with the sampling constants that do not depend on the
+/// shading point (a distant source's cone frame, `1 − cos`, solid angle),
+/// so that a shadow ray does not pay two sines and a frame for them.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct PreparedSource {
+    source: Source,
+    /// Distant sources: the frame around the cone's axis, `1 − cos` of
+    /// its half-angle and its solid angle.
+    distant: Option<(Frame, f64, f64)>,
+}
+
+impl PreparedSource {
+    pub(crate) fn new(source: &Source) -> PreparedSource {
+        let distant = match *source {
+            Source::Distant {
+                dir, half_angle, ..
+            } => Some((
+                Frame::from_z(dir),
+                one_minus_cos(half_angle),
+                cap_solid_angle(half_angle),
+            )),
+            Source::Sphere { .. } => None,
+        };
+        PreparedSource {
+            source: *source,
+            distant,
+        }
+    }
+
+    /// [`Source::sample`], the same numbers.
+    #[inline]
+    pub(crate) fn sample(&self, p: DVec3, u: [f64; 2]) -> Option<SourceSample> {
+        match (self.distant, self.source) {
+            (Some((frame, one_minus_cos_half, omega)), Source::Distant { radiance, .. }) => {
+                Some(SourceSample {
+                    dir: uniform_cone_in(&frame, one_minus_cos_half, u),
+                    distance: f64::INFINITY,
+                    omega,
+                    radiance,
+                })
+            }
+            _ => self.source.sample(p, u),
+        }
+    }
+}
+
 /// What a ray met first.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Hit {
@@ -365,6 +412,28 @@ mod tests {
             dir: DVec3::Z,
         };
         assert!(d.intersect(&off, 1e-9, f64::INFINITY).is_none());
+    }
+
+    #[test]
+    fn prepared_sources_sample_the_same_bits() {
+        let sources = [
+            Source::distant(DVec3::new(0.5, -0.4, 0.7), 0.5, [1e5; 3]),
+            Source::distant(DVec3::new(0.0, 0.0, -1.0), 30.0, [1.0; 3]),
+            Source::Sphere {
+                center: DVec3::new(0.0, 3.0, 10.0),
+                radius: 2.0,
+                radiance: [1.0; 3],
+            },
+        ];
+        let mut rng = crate::rng::Rng::new(3, 4);
+        for source in &sources {
+            let prepared = PreparedSource::new(source);
+            for _ in 0..1000 {
+                let p = DVec3::new(rng.uniform(), rng.uniform(), rng.uniform());
+                let u = rng.uniform2();
+                assert_eq!(prepared.sample(p, u), source.sample(p, u));
+            }
+        }
     }
 
     #[test]

@@ -156,6 +156,8 @@ pub struct Shader {
     orientation: DVec3,
     anisotropic: bool,
     options: EvalOptions,
+    /// Some entry has roughness 0 (mirror and straight-through deltas).
+    has_delta: bool,
 }
 
 impl Shader {
@@ -163,8 +165,10 @@ impl Shader {
     /// are integrated by sampling.
     pub fn new(material: &Material, options: &EvalOptions) -> Shader {
         let options = point_options(options);
+        let entry = Entry::new(material, &options);
         Shader {
-            entries: vec![Entry::new(material, &options)],
+            has_delta: entry.bsdf.is_pure(),
+            entries: vec![entry],
             step: None,
             orientation: material.orientation(),
             anisotropic: material.kind().is_anisotropic(),
@@ -183,6 +187,7 @@ impl Shader {
             })
             .collect::<Result<Vec<_>, TableError>>()?;
         Ok(Shader {
+            has_delta: entries.iter().any(|e| e.bsdf.is_pure()),
             entries,
             step: Some(TABLE_STEP_DEG),
             orientation: DVec3::from_array(table.orientation),
@@ -194,6 +199,12 @@ impl Shader {
     /// The material type.
     pub fn kind(&self) -> MaterialKind {
         self.entries[0].kind
+    }
+
+    /// True if the material (or some θ_in of a table) has roughness 0, so
+    /// [`Self::lobes`] can give delta coefficients.
+    pub fn has_delta(&self) -> bool {
+        self.has_delta
     }
 
     /// True for a θ_in-table shader.
