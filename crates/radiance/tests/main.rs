@@ -1,6 +1,7 @@
 //! brtf-radiance integration tests: primitives here, exports in `export`.
 
 mod export;
+mod klems;
 mod primitive;
 
 use brtf_model::MaterialKind;

@@ -14,6 +14,7 @@
 
 mod cal;
 pub mod klems;
+pub mod klems_cal;
 mod num;
 mod pieces;
 mod preview;
