@@ -16,6 +16,7 @@ mod export;
 mod fit;
 mod info;
 mod klems_fit;
+mod many;
 mod peer;
 mod plot;
 mod render;

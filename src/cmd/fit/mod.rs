@@ -3,6 +3,7 @@
 //! and swapped in as a whole ([`brtf_io::FolderUpdate`]).
 
 mod args;
+mod many;
 
 use crate::cmd::output::print;
 use anyhow::{Context, Result, bail};
@@ -32,6 +33,10 @@ impl Progress for Bar {
 pub fn run(args: FitArgs) -> Result<()> {
     let mut options = args.options(String::new())?;
     options.validate()?;
+    // Folders as inputs: one sample each (`many`).
+    if args.files.iter().any(|f| f.is_dir()) {
+        return many::run(&args, options);
+    }
     let klems = args.files.iter().any(|f| args::is_klems(f));
     options.name = match &args.name {
         Some(name) => name.clone(),
