@@ -68,6 +68,11 @@ pub struct KlemsArgs {
     /// Add CIE-X and CIE-Z bands (colour).
     #[arg(long, requires = "klems")]
     pub colour: bool,
+    /// With --klems --material: also write `<name>-bsdf2klems.cal`, the
+    /// material's BSDF (CIE Y) as the six-argument function
+    /// `bsdf2klems -f` takes, for an independent Klems file from Radiance.
+    #[arg(long, requires = "material")]
+    pub klems_cal: bool,
     /// `Manufacturer` in the Klems file.
     #[arg(long, default_value = "brtf", requires = "klems")]
     pub manufacturer: String,
@@ -191,10 +196,18 @@ fn run_klems(args: ExportArgs) -> Result<()> {
         brtf_io::ensure_folder(&out)?;
         let path = out.join(format!("{name}.xml"));
         klems::write_klems(&path, &export)?;
+        let mut lines = format!("wrote {}\n", path.display());
+        if k.klems_cal {
+            let cal = brtf_radiance::export::klems_cal::bsdf_function_cal(&material)
+                .map_err(|e| anyhow::anyhow!("--klems-cal: {e}"))?;
+            let cal_path = out.join(format!("{name}-bsdf2klems.cal"));
+            brtf_io::write_atomic(&cal_path, cal.as_bytes())?;
+            lines += &format!("wrote {}\n", cal_path.display());
+        }
         for note in &export.notes {
             say!("note: {note}");
         }
-        return print(&format!("wrote {}\n", path.display()));
+        return print(&lines);
     }
 
     let dir = args.dir.context("give the fit folder or --material")?;

@@ -15,6 +15,7 @@ mod eval;
 mod export;
 mod fit;
 mod info;
+mod klems_export;
 mod klems_fit;
 mod many;
 mod peer;
