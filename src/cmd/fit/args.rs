@@ -14,7 +14,9 @@ use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub struct FitArgs {
-    /// Measurement files, one incidence each (.mpc or pab-opto Mountain).
+    /// Measurement files, one incidence each (.mpc or pab-opto Mountain), or
+    /// sample folders, one sample each (its .mpc and .txt files), each
+    /// fitted into OUT/<name>/.
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
     /// Model to fit: plastic, metal, trans, plastic2, metal2 or trans2.
@@ -23,7 +25,8 @@ pub struct FitArgs {
     /// Tie R = G = B (always so for single-channel data).
     #[arg(long)]
     pub gray: bool,
-    /// Output folder, replaced as a whole [default: fits/<name>].
+    /// Output folder, replaced as a whole [default: fits/<name>]; with sample
+    /// folders, the folder of their fit folders [default: fits].
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Replace an output folder that holds another fit or other files.
