@@ -47,5 +47,10 @@ fn bench(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench);
+criterion_group! {
+    name = benches;
+    // No plots: criterion's plotting panics on a machine without fonts.
+    config = Criterion::default().without_plots();
+    targets = bench
+}
 criterion_main!(benches);

@@ -422,6 +422,37 @@ impl Material {
         Ok(brtf_radiance::format_primitive(&primitive))
     }
 
+    /// For `scripts/bench-python.py` only: seconds the Rust loop behind
+    /// `eval` takes on these directions, with inputs and output already
+    /// in Rust vectors (as the criterion bench), so that Python and Rust
+    /// can be timed alternately in one process under the same load.
+    #[pyo3(signature = (theta_in, phi_in, theta_out, phi_out, per_row = false))]
+    fn _kernel_seconds(
+        &self,
+        py: Python<'_>,
+        theta_in: f64,
+        phi_in: f64,
+        theta_out: Vec<f64>,
+        phi_out: Vec<f64>,
+        per_row: bool,
+    ) -> f64 {
+        let n = theta_out.len().min(phi_out.len());
+        let (ti, pi) = (vec![theta_in; n], vec![phi_in; n]);
+        let mut out = vec![0.0; 3 * n];
+        py.detach(|| {
+            let start = std::time::Instant::now();
+            if per_row {
+                kernel::eval_degrees(&self.bsdf, &ti, &pi, &theta_out, &phi_out, &mut out);
+            } else {
+                kernel::eval_degrees_one_incidence(
+                    &self.bsdf, theta_in, phi_in, &theta_out, &phi_out, &mut out,
+                );
+            }
+            std::hint::black_box(&out);
+            start.elapsed().as_secs_f64()
+        })
+    }
+
     fn __repr__(&self) -> String {
         let args: Vec<String> = self.model.args().iter().map(|a| a.to_string()).collect();
         let mut text = format!(
