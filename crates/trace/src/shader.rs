@@ -207,6 +207,13 @@ impl Shader {
         self.has_delta
     }
 
+    /// The one BSDF of a single-material shader (`None` for a table),
+    /// for batch evaluation: [`Self::eval`] with `degenerate = false` is
+    /// this BSDF's `eval`.
+    pub(crate) fn single_bsdf(&self) -> Option<&Bsdf> {
+        self.step.is_none().then(|| &self.entries[0].bsdf)
+    }
+
     /// True for a θ_in-table shader.
     pub fn is_table(&self) -> bool {
         self.step.is_some()

@@ -134,3 +134,80 @@ fn lambertian_floor_under_a_sphere_light() {
     assert!((got - want).abs() < 0.01 * want, "{got} vs {want}");
     let _ = auto_exposure;
 }
+
+/// The batched direct-light rows (one `eval_batch` per row and shader)
+/// give every pixel and every ray count of the per-ray tracer.
+#[test]
+fn batched_direct_rows_equal_the_per_ray_tracer() {
+    use brtf_trace::integrator::RayCounts;
+    use brtf_trace::{Rng, Tracer};
+    let mut scene = scene();
+    // A second, transmitting material lit from behind, and a sphere light.
+    let glass = mat(MaterialKind::Trans, &[0.7, 0.8, 0.9, 0.04, 0.05, 0.6, 0.3]);
+    let id = scene.add_shader(Shader::new(&glass, &EvalOptions::default()));
+    scene.add(
+        Shape::Sphere {
+            center: DVec3::new(1.5, -1.0, 0.6),
+            radius: 0.6,
+        },
+        id,
+    );
+    scene.sources.push(Source::Sphere {
+        center: DVec3::new(-2.0, 2.0, 4.0),
+        radius: 0.5,
+        radiance: [50.0, 40.0, 30.0],
+    });
+    let (w, h) = (48, 36);
+    let camera = Camera::look_at(
+        DVec3::new(6.0, -6.0, 4.0),
+        DVec3::new(0.0, 0.0, 0.7),
+        40.0,
+        w as f64 / h as f64,
+    );
+    let settings = Settings {
+        source_samples: 2,
+        ..Settings::direct_only()
+    };
+    let options = ImageOptions {
+        width: w,
+        height: h,
+        samples: 3,
+        jitter: true,
+        seed: 7,
+        settings,
+    };
+    let rendered = render(&scene, &camera, &options);
+    let tracer = Tracer::new(&scene, settings);
+    let mut counts = RayCounts::default();
+    let mut lit = 0;
+    for j in 0..h {
+        for i in 0..w {
+            let mut rng = Rng::new(options.seed, (j * w + i) as u64);
+            let mut sum = [0.0; 3];
+            for _ in 0..options.samples {
+                let (du, dv) = (rng.uniform(), rng.uniform());
+                let ray = camera.pixel_ray(i, j, w, h, du, dv);
+                let l = tracer.radiance(&ray, &mut rng, &mut counts);
+                for k in 0..3 {
+                    sum[k] += l[k];
+                }
+            }
+            let want = sum.map(|s| (s / options.samples as f64) as f32);
+            let got = rendered.picture.pixels[j * w + i];
+            for k in 0..3 {
+                let tol = 1e-6 * want[k].abs().max(got[k].abs()) + 1e-30;
+                assert!(
+                    (got[k] - want[k]).abs() <= tol,
+                    "pixel ({i}, {j}) channel {k}: batched {} vs per-ray {}",
+                    got[k],
+                    want[k]
+                );
+            }
+            // Misses show the background, 0.1.
+            lit += usize::from(want[1] > 0.2);
+        }
+    }
+    assert_eq!(rendered.rays, counts);
+    assert!(counts.shadow > 1000, "too few shadow rays: {counts:?}");
+    assert!(lit > w * h / 4, "only {lit} lit pixels");
+}
