@@ -56,7 +56,8 @@ pub struct KlemsArgs {
     #[arg(long, default_value = "classic", value_parser = super::material::parse_fresnel_k,
           requires = "material")]
     pub fresnel_k: f64,
-    /// Samples per Klems matrix entry (stratified over both patches).
+    /// Samples per Klems matrix entry: quasi-random points of the outgoing
+    /// × incident patch (16× near the horizon, 4× above 75°).
     #[arg(long, value_name = "N", requires = "klems",
           default_value_t = brtf_gonio::klems::model_matrix::DEFAULT_SAMPLES)]
     pub klems_samples: usize,

@@ -134,6 +134,9 @@ pub struct KlemsExport {
 struct SideModel {
     bsdfs: Vec<Bsdf>,
     transmitting: bool,
+    /// The same model as the front's (a two-sided material): reuse the
+    /// front's matrices instead of computing them again.
+    same_as_front: bool,
 }
 
 /// The fit's evaluation options for export: its variant and Fresnel
@@ -175,6 +178,7 @@ fn side_from_fit(
     Ok(SideModel {
         bsdfs,
         transmitting: result.config.kind.is_transmitting(),
+        same_as_front: false,
     })
 }
 
@@ -269,9 +273,12 @@ pub fn klems_from_material(
     options: &KlemsOptions,
 ) -> Result<KlemsExport, KlemsExportError> {
     let bsdf = Bsdf::new(material, eval);
-    let side = || SideModel {
+    // brtf-model turns the surface towards the viewer, so light from the
+    // back sees exactly the front's BSDF: the back matrices are the front's.
+    let side = |same_as_front| SideModel {
         bsdfs: vec![bsdf; options.basis.len()],
         transmitting: material.kind().is_transmitting(),
+        same_as_front,
     };
     let comment = vec![
         format!(
@@ -295,7 +302,7 @@ pub fn klems_from_material(
         ),
     ];
     build(
-        vec![(Side::Front, side()), (Side::Back, side())],
+        vec![(Side::Front, side(false)), (Side::Back, side(true))],
         options,
         comment,
         Vec::new(),
@@ -346,20 +353,19 @@ fn build(
         )));
     }
     let basis = &options.basis;
-    let computed: Vec<(Side, SideMatrices)> = sides
-        .iter()
-        .map(|(side, model)| {
-            (
-                *side,
-                model_matrix::side_matrices(
-                    basis,
-                    &model.bsdfs,
-                    model.transmitting,
-                    options.sampling,
-                ),
-            )
-        })
-        .collect();
+    let mut computed: Vec<(Side, SideMatrices)> = Vec::new();
+    for (side, model) in &sides {
+        let matrices = match computed.first() {
+            Some((_, front)) if model.same_as_front => front.clone(),
+            _ => model_matrix::side_matrices(
+                basis,
+                &model.bsdfs,
+                model.transmitting,
+                options.sampling,
+            ),
+        };
+        computed.push((*side, matrices));
+    }
     let mut bands = vec![KlemsBand::Visible];
     if options.colour {
         bands.push(KlemsBand::CieX);
@@ -424,13 +430,14 @@ fn build(
                     material.kind()
                 ));
             }
+            // One static material: the same matrices for both sides.
+            let m = model_matrix::side_matrices(
+                basis,
+                &vec![bsdf; basis.len()],
+                transmitting,
+                options.sampling,
+            );
             for (side, _) in &sides {
-                let m = model_matrix::side_matrices(
-                    basis,
-                    &vec![bsdf; basis.len()],
-                    transmitting,
-                    options.sampling,
-                );
                 for (direction, rgb) in order(*side, &m) {
                     blocks.push(KlemsWriteBlock {
                         band: KlemsBand::Solar,
