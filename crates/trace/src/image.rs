@@ -12,7 +12,7 @@ use std::time::{Duration, Instant};
 
 use crate::camera::Camera;
 use crate::hdr::Picture;
-use crate::integrator::{RayCounts, Settings, Tracer};
+use crate::integrator::{DirectBatch, RayCounts, Settings, Tracer};
 use crate::rng::Rng;
 use crate::scene::Scene;
 
@@ -68,10 +68,11 @@ pub fn render(scene: &Scene, camera: &Camera, options: &ImageOptions) -> Rendere
     let n = options.samples.max(1);
     let rows: Vec<(Vec<[f32; 3]>, RayCounts)> = (0..h)
         .into_par_iter()
-        .map(|j| {
+        // One batch buffer per worker, reused row after row.
+        .map_init(DirectRow::default, |direct, j| {
             let mut counts = RayCounts::default();
             if direct_batch {
-                return (direct_row(&tracer, camera, options, j, &mut counts), counts);
+                return (direct.row(&tracer, camera, options, j, &mut counts), counts);
             }
             let row = (0..w)
                 .map(|i| {
@@ -113,47 +114,59 @@ pub fn render(scene: &Scene, camera: &Camera, options: &ImageOptions) -> Rendere
     }
 }
 
-/// Row `j` when the picture is direct light only: every camera ray of the
-/// row is traced and its source samples queued, then their BSDF values
-/// come from one batch evaluation and the shadow rays follow. Draws the
-/// same random numbers in the same order as the per-ray loop.
-fn direct_row(
-    tracer: &Tracer,
-    camera: &Camera,
-    options: &ImageOptions,
-    j: usize,
-    counts: &mut RayCounts,
-) -> Vec<[f32; 3]> {
-    let (w, h) = (options.width, options.height);
-    let n = options.samples.max(1) as usize;
-    let mut batch = tracer.direct_batch();
-    let mut radiance: Vec<Rgb> = vec![[0.0; 3]; w * n];
-    for i in 0..w {
-        let mut rng = Rng::new(options.seed, (j * w + i) as u64);
-        for s in 0..n {
-            let (du, dv) = if options.jitter {
-                (rng.uniform(), rng.uniform())
-            } else {
-                (0.5, 0.5)
-            };
-            let ray = camera.pixel_ray(i, j, w, h, du, dv);
-            let slot = i * n + s;
-            radiance[slot] = tracer.direct_start(&ray, slot, &mut rng, counts, &mut batch);
-        }
-    }
-    tracer.direct_finish(&mut batch, &mut radiance, counts);
-    radiance
-        .chunks_exact(n)
-        .map(|samples| {
-            let mut sum: Rgb = [0.0; 3];
-            for l in samples {
-                for k in 0..3 {
-                    sum[k] += l[k];
-                }
+/// The buffers of [`DirectRow::row`], kept between rows.
+#[derive(Debug, Default)]
+struct DirectRow {
+    batch: Option<DirectBatch>,
+    radiance: Vec<Rgb>,
+}
+
+impl DirectRow {
+    /// Row `j` when the picture is direct light only: every camera ray of
+    /// the row is traced and its source samples queued, then their BSDF
+    /// values come from one batch evaluation and the shadow rays follow.
+    /// Draws the same random numbers in the same order as the per-ray loop.
+    fn row(
+        &mut self,
+        tracer: &Tracer,
+        camera: &Camera,
+        options: &ImageOptions,
+        j: usize,
+        counts: &mut RayCounts,
+    ) -> Vec<[f32; 3]> {
+        let (w, h) = (options.width, options.height);
+        let n = options.samples.max(1) as usize;
+        let batch = self.batch.get_or_insert_with(|| tracer.direct_batch());
+        let radiance = &mut self.radiance;
+        radiance.clear();
+        radiance.resize(w * n, [0.0; 3]);
+        for i in 0..w {
+            let mut rng = Rng::new(options.seed, (j * w + i) as u64);
+            for s in 0..n {
+                let (du, dv) = if options.jitter {
+                    (rng.uniform(), rng.uniform())
+                } else {
+                    (0.5, 0.5)
+                };
+                let ray = camera.pixel_ray(i, j, w, h, du, dv);
+                let slot = i * n + s;
+                radiance[slot] = tracer.direct_start(&ray, slot, &mut rng, counts, batch);
             }
-            sum.map(|s| (s / n as f64) as f32)
-        })
-        .collect()
+        }
+        tracer.direct_finish(batch, radiance, counts);
+        radiance
+            .chunks_exact(n)
+            .map(|samples| {
+                let mut sum: Rgb = [0.0; 3];
+                for l in samples {
+                    for k in 0..3 {
+                        sum[k] += l[k];
+                    }
+                }
+                sum.map(|s| (s / n as f64) as f32)
+            })
+            .collect()
+    }
 }
 
 /// Luminance-like brightness of an RGB value (Radiance's `bright()`).
