@@ -8,13 +8,17 @@
 //!   `report.html`), into a temporary folder. The target of issue 18 is
 //!   40 ms.
 //! * `plots/load`: only the rebuild of the data ([`brtf_plot::prepare::load`]).
+//! * `plots/coverage`: the nearest-sample grid of the front disk
+//!   ([`brtf_plot::disk::Coverage`]), which the map and the reflectance
+//!   chart share.
 //! * `plots/map_png`, `plots/map_svg`: the residual map alone, on data
 //!   already loaded (its nearest-sample grid made afresh each time).
 
 use brtf_fit::{FitConfig, FitSetOptions, NoProgress, Recipe};
+use brtf_gonio::Hemisphere;
 use brtf_model::MaterialKind;
 use brtf_plot::charts::map::MapChart;
-use brtf_plot::{PlotOptions, figure, prepare};
+use brtf_plot::{PlotOptions, disk, figure, prepare};
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 use std::path::{Path, PathBuf};
@@ -64,6 +68,24 @@ fn plots(c: &mut Criterion) {
     group.bench_function("load", |b| {
         b.iter(|| prepare::load(result, 0, "t".into(), out.path(), &[]).unwrap())
     });
+    let inc = prepare::load(result, 0, "t".into(), out.path(), &[]).unwrap();
+    let (ids, points): (Vec<u32>, Vec<(f64, f64)>) = inc
+        .samples
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| s.hemisphere() == Hemisphere::Front)
+        .map(|(k, s)| (k as u32, disk::project(s.dir, Hemisphere::Front)))
+        .unzip();
+    group.bench_function("coverage", |b| {
+        b.iter(|| {
+            disk::Coverage::new(
+                black_box(&points),
+                &ids,
+                disk::COVERAGE_SIZE,
+                disk::radius_of(disk::FILL_DEG),
+            )
+        })
+    });
     group.bench_function("map_png", |b| {
         b.iter_batched(
             || prepare::load(result, 0, "t".into(), out.path(), &[]).unwrap(),
@@ -87,5 +109,10 @@ fn plots(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, plots);
+criterion_group! {
+    name = benches;
+    // No report charts: criterion's own plotters output finds no font.
+    config = Criterion::default().without_plots();
+    targets = plots
+}
 criterion_main!(benches);

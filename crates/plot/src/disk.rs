@@ -78,12 +78,21 @@ pub fn cone_outline(axis: DVec3, half_deg: f64, hemisphere: Hemisphere) -> Vec<V
 }
 
 /// A uniform bucket grid over the projected disk for nearest-point queries.
+/// The points are stored cell by cell, row-major, so the cells of one grid
+/// row are one contiguous run.
 struct Grid {
     cell: f64,
     n: usize,
+    /// Cell `c` holds `sorted[start[c]..start[c + 1]]`.
     start: Vec<u32>,
+    /// The original index of each stored point.
     items: Vec<u32>,
-    points: Vec<(f64, f64)>,
+    /// The points in cell order.
+    sorted: Vec<(f64, f64)>,
+    /// Summed-area table of the cell counts, `(n + 1)²`: how many points a
+    /// block of cells holds, so empty blocks (gaps in the scan) cost
+    /// nothing to search.
+    summed: Vec<u32>,
 }
 
 impl Grid {
@@ -103,17 +112,65 @@ impl Grid {
         }
         let mut fill = counts.clone();
         let mut items = vec![0u32; points.len()];
+        let mut sorted = vec![(0.0, 0.0); points.len()];
         for (p, &i) in index.iter().enumerate() {
             items[fill[i] as usize] = p as u32;
+            sorted[fill[i] as usize] = points[p];
             fill[i] += 1;
+        }
+        let mut summed = vec![0u32; (n + 1) * (n + 1)];
+        for iy in 0..n {
+            let mut row = 0;
+            for ix in 0..n {
+                let c = iy * n + ix;
+                row += counts[c + 1] - counts[c];
+                summed[(iy + 1) * (n + 1) + ix + 1] = summed[iy * (n + 1) + ix + 1] + row;
+            }
         }
         Grid {
             cell,
             n,
             start: counts,
             items,
-            points,
+            sorted,
+            summed,
         }
+    }
+
+    /// Points in the cells `x0..=x1` × `y0..=y1`.
+    fn count(&self, (x0, x1): (usize, usize), (y0, y1): (usize, usize)) -> u32 {
+        let w = self.n + 1;
+        let at = |x: usize, y: usize| self.summed[y * w + x];
+        at(x1 + 1, y1 + 1) + at(x0, y0) - at(x0, y1 + 1) - at(x1 + 1, y0)
+    }
+
+    /// Nearest point to (x, y) no farther than `r` (ties: the lower index),
+    /// found among the cells that meet the square of half-side `r`.
+    fn nearest_within(&self, x: f64, y: f64, r: f64) -> Option<(usize, f64)> {
+        let n = self.n as isize;
+        let cell_index =
+            |v: f64| (((v + RADIUS) / self.cell).floor() as isize).clamp(0, n - 1) as usize;
+        let (x0, x1) = (cell_index(x - r), cell_index(x + r));
+        let (y0, y1) = (cell_index(y - r), cell_index(y + r));
+        if self.count((x0, x1), (y0, y1)) == 0 {
+            return None;
+        }
+        let r2 = r * r;
+        let mut best: Option<(u32, f64)> = None;
+        for iy in y0..=y1 {
+            let row = iy * self.n;
+            let (a, b) = (
+                self.start[row + x0] as usize,
+                self.start[row + x1 + 1] as usize,
+            );
+            for (&(px, py), &p) in self.sorted[a..b].iter().zip(&self.items[a..b]) {
+                let d2 = (px - x) * (px - x) + (py - y) * (py - y);
+                if d2 <= r2 && best.is_none_or(|(bp, b)| d2 < b || (d2 == b && p < bp)) {
+                    best = Some((p, d2));
+                }
+            }
+        }
+        best.map(|(p, d2)| (p as usize, d2.sqrt()))
     }
 
     fn cell_of(x: f64, y: f64, cell: f64, n: usize) -> usize {
@@ -136,14 +193,14 @@ impl Grid {
                     return;
                 }
                 let c = (iy * n + ix) as usize;
-                for &p in &self.items[self.start[c] as usize..self.start[c + 1] as usize] {
+                let (a, b) = (self.start[c] as usize, self.start[c + 1] as usize);
+                for (&(px, py), &p) in self.sorted[a..b].iter().zip(&self.items[a..b]) {
                     let p = p as usize;
                     if Some(p) == skip {
                         continue;
                     }
-                    let (px, py) = self.points[p];
                     let d2 = (px - x) * (px - x) + (py - y) * (py - y);
-                    if best.is_none_or(|(_, b)| d2 < b) {
+                    if best.is_none_or(|(bp, b)| d2 < b || (d2 == b && p < bp)) {
                         best = Some((p, d2));
                     }
                 }
@@ -215,7 +272,8 @@ impl Coverage {
         let min_reach = min_reach.max(pixel);
         // Typical spacing: the mean area per point.
         let spacing = (std::f64::consts::PI * RADIUS * RADIUS / points.len() as f64).sqrt();
-        let grid = Grid::new(points.to_vec(), spacing.max(0.25 * min_reach));
+        // About one point per cell: the searches below look at few points.
+        let grid = Grid::new(points.to_vec(), spacing);
         // Isolated samples reach at most a few typical spacings, which also
         // bounds the search of pixels in gaps.
         let far = (4.0 * spacing).max(min_reach);
@@ -235,12 +293,24 @@ impl Coverage {
             .enumerate()
             .for_each(|(j, row)| {
                 let y = RADIUS - (j as f64 + 0.5) * pixel;
+                // The previous pixel's nearest point bounds this pixel's
+                // nearest distance: only the cells within that bound are
+                // searched (the exact nearest all the same).
+                let mut previous: Option<usize> = None;
                 for (i, cell) in row.iter_mut().enumerate() {
                     let x = -RADIUS + (i as f64 + 0.5) * pixel;
                     if x * x + y * y > rim2 {
                         continue;
                     }
-                    if let Some((k, d)) = grid.nearest(x, y, far, None)
+                    let bound = previous.map_or(far, |k| {
+                        let (px, py) = points[k];
+                        let d = ((px - x) * (px - x) + (py - y) * (py - y)).sqrt();
+                        // A hair wider, so that point itself is found again.
+                        (d * (1.0 + 1e-9) + 1e-12).min(far)
+                    });
+                    let nearest = grid.nearest_within(x, y, bound);
+                    previous = nearest.map(|(k, _)| k);
+                    if let Some((k, d)) = nearest.filter(|&(_, d)| d <= far)
                         && (d <= min_reach || d <= reach_of(k))
                     {
                         *cell = ids[k];
@@ -327,6 +397,78 @@ mod tests {
         let r = c.resampled(50);
         assert_ne!(r[(25 * 50 + 12) as usize], NONE);
         assert_eq!(r[(25 * 50 + 40) as usize], NONE);
+    }
+
+    #[test]
+    fn coverage_matches_brute_force() {
+        // Scattered points with a dense cluster, a gap and repeated points.
+        let mut state = 7u64;
+        let mut uniform = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut pts = Vec::new();
+        while pts.len() < 1500 {
+            let (x, y) = (
+                RADIUS * (2.0 * uniform() - 1.0),
+                RADIUS * (2.0 * uniform() - 1.0),
+            );
+            let dense = pts.len() % 3 == 0;
+            let (x, y) = if dense {
+                (0.3 + 0.1 * x, -0.2 + 0.1 * y)
+            } else {
+                (x, y)
+            };
+            if x * x + y * y < RADIUS * RADIUS && !(x > 0.6 && y > 0.2) {
+                pts.push((x, y));
+            }
+        }
+        pts.extend_from_within(..20);
+        let ids: Vec<u32> = (0..pts.len() as u32).map(|k| k * 2 + 1).collect();
+        let (size, min_reach) = (96, radius_of(2.0));
+        let c = Coverage::new(&pts, &ids, size, min_reach);
+        let pixel = 2.0 * RADIUS / size as f64;
+        let spacing = (std::f64::consts::PI * RADIUS * RADIUS / pts.len() as f64).sqrt();
+        let far = (4.0 * spacing).max(min_reach.max(pixel));
+        let dist = |a: (f64, f64), b: (f64, f64)| (a.0 - b.0).hypot(a.1 - b.1);
+        let reach: Vec<f64> = (0..pts.len())
+            .map(|k| {
+                let d = (0..pts.len())
+                    .filter(|&m| m != k)
+                    .map(|m| dist(pts[k], pts[m]))
+                    .fold(f64::INFINITY, f64::min);
+                d.min(far).max(min_reach.max(pixel))
+            })
+            .collect();
+        let mut covered = 0;
+        for j in 0..size {
+            for i in 0..size {
+                let q = (
+                    -RADIUS + (i as f64 + 0.5) * pixel,
+                    RADIUS - (j as f64 + 0.5) * pixel,
+                );
+                let mut expected = NONE;
+                if q.0 * q.0 + q.1 * q.1 <= RADIUS * RADIUS {
+                    // The nearest point, the lower index on ties.
+                    let (k, d) = (0..pts.len())
+                        .map(|k| (k, dist(q, pts[k])))
+                        .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)))
+                        .unwrap();
+                    if d <= far && (d <= min_reach.max(pixel) || d <= reach[k]) {
+                        expected = ids[k];
+                        covered += 1;
+                    }
+                }
+                assert_eq!(
+                    c.owner[(j * size + i) as usize],
+                    expected,
+                    "pixel ({i}, {j})"
+                );
+            }
+        }
+        assert!(covered > 1000, "{covered}");
     }
 
     #[test]

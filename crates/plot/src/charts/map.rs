@@ -17,6 +17,7 @@ use brtf_gonio::Hemisphere;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, VPos};
+use std::sync::{Arc, Mutex, OnceLock};
 
 /// Side of one hemisphere's square in pixels.
 const DISK: u32 = 640;
@@ -24,6 +25,12 @@ const DISK: u32 = 640;
 const PANEL: u32 = 350;
 /// Extent of the map's coordinates (the rim is at √2).
 const EXTENT: f64 = RADIUS * 1.2;
+
+/// Which raster: hemisphere and side in pixels.
+type RasterKey = (Hemisphere, u32);
+
+/// RGBA pixels made once by whichever rendering needs them first.
+type SharedRaster = Arc<OnceLock<Vec<u8>>>;
 
 /// The residual map of one incidence.
 pub struct MapChart<'a> {
@@ -35,6 +42,9 @@ pub struct MapChart<'a> {
     pub ratio: f64,
     /// The fit's RMS relative error of this incidence.
     pub rms_rel: f64,
+    /// The rasters drawn so far, by hemisphere and size: the SVG and the
+    /// PNG (drawn at the same time) share them.
+    rasters: Mutex<Vec<(RasterKey, SharedRaster)>>,
 }
 
 impl<'a> MapChart<'a> {
@@ -45,6 +55,7 @@ impl<'a> MapChart<'a> {
             title,
             ratio,
             rms_rel,
+            rasters: Mutex::new(Vec::new()),
         }
     }
 
@@ -67,13 +78,32 @@ impl<'a> MapChart<'a> {
         [c.0, c.1, c.2]
     }
 
-    /// The RGBA raster of one hemisphere, `size` pixels square.
+    /// The RGBA raster of one hemisphere, `size` pixels square (made once).
     fn raster(&self, hemisphere: Hemisphere, size: u32) -> Vec<u8> {
+        let slot = {
+            let mut rasters = self.rasters.lock().unwrap_or_else(|e| e.into_inner());
+            let key = (hemisphere, size);
+            match rasters.iter().find(|(k, _)| *k == key) {
+                Some((_, slot)) => Arc::clone(slot),
+                None => {
+                    let slot = Arc::new(OnceLock::new());
+                    rasters.push((key, Arc::clone(&slot)));
+                    slot
+                }
+            }
+        };
+        slot.get_or_init(|| self.paint(hemisphere, size)).clone()
+    }
+
+    /// Colours the pixels of one hemisphere by their nearest sample.
+    fn paint(&self, hemisphere: Hemisphere, size: u32) -> Vec<u8> {
         let owner = self.inc.coverage(hemisphere).resampled(size);
+        // One colour per sample (a logarithm each), looked up per pixel.
+        let colours: Vec<[u8; 3]> = self.inc.samples.iter().map(|s| self.colour_of(s)).collect();
         let mut rgba = vec![0u8; owner.len() * 4];
         for (px, &o) in rgba.chunks_exact_mut(4).zip(&owner) {
             if o != disk::NONE {
-                px[..3].copy_from_slice(&self.colour_of(&self.inc.samples[o as usize]));
+                px[..3].copy_from_slice(&colours[o as usize]);
                 px[3] = 255;
             }
         }
