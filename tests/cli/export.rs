@@ -60,7 +60,6 @@ fn report(kind: MaterialKind, theta_in: f64, args: &[f64]) -> FitReport {
         n_points: 2000,
         gates: Vec::new(),
         weighting: brtf_fit::Weighting::Caller,
-        patch_pairs: None,
         rms_rel: 0.012,
         cost: 0.5,
         floor: 0.0,

@@ -115,8 +115,8 @@ impl Default for PatchAveraging {
     fn default() -> Self {
         PatchAveraging {
             outgoing_samples: 32,
-            incident_samples: 8,
-            near_lobe_deg: 25.0,
+            incident_samples: 16,
+            near_lobe_deg: 35.0,
             seed: 1,
         }
     }

@@ -180,7 +180,14 @@ pub fn fit_set(
         assess(&inputs, &mut reports, &config, progress)?;
     }
 
-    let table = match ParamTable::from_reports(
+    // Klems incidences come in θ rings of azimuth patches: the table
+    // averages each ring over φ_in.
+    let build = if recipe.patch_average.is_some() {
+        ParamTable::from_reports_phi_averaged
+    } else {
+        ParamTable::from_reports
+    };
+    let table = match build(
         config.kind,
         config.orientation,
         &reports,

@@ -89,6 +89,45 @@ impl ParamTable {
         })
     }
 
+    /// The table of incidences that share θ_in rings, as a Klems basis
+    /// has (one incidence per azimuth patch): each θ_in's material
+    /// arguments are averaged over its incidences (over φ_in), which suits
+    /// isotropic materials; rows with one incidence are kept as they are.
+    pub fn from_reports_phi_averaged(
+        kind: MaterialKind,
+        orientation: [f64; 3],
+        reports: &[FitReport],
+        method: Interpolation,
+    ) -> Result<ParamTable, TableError> {
+        let mut rings: Vec<(f64, Vec<f64>, usize)> = Vec::new();
+        let mut order: Vec<&FitReport> = reports.iter().collect();
+        order.sort_by(|a, b| a.theta_in.total_cmp(&b.theta_in));
+        for r in order {
+            match rings.last_mut() {
+                Some((theta, sum, count)) if (r.theta_in - *theta).abs() < 1e-9 => {
+                    for (s, a) in sum.iter_mut().zip(&r.material_args) {
+                        *s += a;
+                    }
+                    *count += 1;
+                }
+                _ => rings.push((r.theta_in, r.material_args.clone(), 1)),
+            }
+        }
+        if rings.len() < 2 {
+            return Err(TableError::NeedTwoIncidences(rings.len()));
+        }
+        Ok(ParamTable {
+            kind,
+            orientation,
+            method,
+            theta_in: rings.iter().map(|r| r.0).collect(),
+            args: rings
+                .into_iter()
+                .map(|(_, sum, count)| sum.into_iter().map(|s| s / count as f64).collect())
+                .collect(),
+        })
+    }
+
     /// Measured θ_in range.
     pub fn range(&self) -> (f64, f64) {
         (
