@@ -234,3 +234,51 @@ fn fits_recover_trans_materials_from_radiance_made_klems_files() {
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+/// `brtf fit --en14501` prints a `trans` whose own normal-incidence values
+/// are the datasheet's (brtf-model is exact to rtrace), and refuses values
+/// that cannot be a material.
+#[test]
+fn en14501_values_give_a_trans_with_those_values() {
+    let out = brtf(
+        &[
+            "fit",
+            "--en14501",
+            "tau_nh=0.12,tau_nn=0.05,rho_nh=0.6",
+            "--name",
+            "screen",
+        ],
+        "",
+    )
+    .ok();
+    assert!(out.contains("void trans screen\n0\n0\n7 0.720000 0.720000 0.720000 0.000000 0.000000 0.166667 0.416667"), "{out}");
+    assert!(
+        out.contains("rho_nh=0.6000 tau_nh=0.1200 tau_nn=0.0500"),
+        "{out}"
+    );
+    // A specular part switches Radiance's roughness-0 Fresnel factor on.
+    let out = brtf(
+        &[
+            "fit",
+            "--en14501",
+            "tau_nh=0.3,tau_nn=0.1,rho_nh=0.45,spec=0.03",
+        ],
+        "",
+    )
+    .ok();
+    assert!(
+        out.contains("rho_nh=0.4500 tau_nh=0.3000 tau_nn=0.1000"),
+        "{out}"
+    );
+    for (values, message) in [
+        ("tau_nh=0.5,tau_nn=0.05,rho_nh=0.6", "exceeds 1"),
+        (
+            "tau_nh=0.1,tau_nn=0.2,rho_nh=0.6",
+            "tau_nn = 0.2 exceeds tau_nh",
+        ),
+        ("tau_nh=0.1,rho_nh=0.6", "tau_nn is missing"),
+    ] {
+        let err = brtf(&["fit", "--en14501", values], "").err();
+        assert!(err.contains(message), "{values}: {err}");
+    }
+}

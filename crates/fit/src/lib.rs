@@ -32,6 +32,7 @@
 mod config;
 mod data;
 mod diagnose;
+pub mod en14501;
 mod fitter;
 pub mod klems;
 mod params;

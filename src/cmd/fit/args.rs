@@ -17,11 +17,17 @@ pub struct FitArgs {
     /// Measurement files, one incidence each (.mpc or pab-opto Mountain), or
     /// sample folders, one sample each (its .mpc and .txt files), each
     /// fitted into OUT/<name>/.
-    #[arg(required = true)]
+    #[arg(required_unless_present = "en14501")]
     pub files: Vec<PathBuf>,
     /// Model to fit: plastic, metal, trans, plastic2, metal2 or trans2.
-    #[arg(long, value_parser = |s: &str| s.parse::<MaterialKind>())]
-    pub model: MaterialKind,
+    #[arg(long, required_unless_present = "en14501", value_parser = |s: &str| s.parse::<MaterialKind>())]
+    pub model: Option<MaterialKind>,
+    /// No files: a grey roughness-0 `trans` from datasheet values at normal
+    /// incidence (EN 14501), `tau_nh=…,tau_nn=…,rho_nh=…[,spec=…]`, printed
+    /// as a Radiance material (docs/fitting.md, "EN 14501 shortcut").
+    #[arg(long, value_name = "VALUES", conflicts_with_all = ["files", "model"],
+          value_parser = |s: &str| s.parse::<brtf_fit::en14501::En14501>())]
+    pub en14501: Option<brtf_fit::en14501::En14501>,
     /// Tie R = G = B (always so for single-channel data).
     #[arg(long)]
     pub gray: bool,
@@ -188,6 +194,9 @@ pub enum InterpArg {
 impl FitArgs {
     /// The library's options for these arguments.
     pub fn options(&self, name: String) -> Result<FitSetOptions> {
+        let Some(model) = self.model else {
+            bail!("--model is needed to fit measurement files");
+        };
         let [x, y, z] = self.orientation[..] else {
             bail!("--orientation needs three numbers x,y,z, not all zero");
         };
@@ -198,7 +207,7 @@ impl FitArgs {
             Some(HemisphereArg::Front) => Some(Hemisphere::Front),
             Some(HemisphereArg::Back) => Some(Hemisphere::Back),
             Some(HemisphereArg::Both) => None,
-            None if self.model.is_transmitting() => None,
+            None if model.is_transmitting() => None,
             None => Some(Hemisphere::Front),
         };
         let klems = self.files.iter().filter(|f| is_klems(f)).count();
@@ -234,7 +243,7 @@ impl FitArgs {
             outgoing_samples: self.patch_samples,
             ..Default::default()
         });
-        let mut config = FitConfig::new(self.model);
+        let mut config = FitConfig::new(model);
         config.options.variant = self.formula.variant;
         config.options.fresnel_k = self.formula.fresnel_k;
         config.options.source_omega = self.source_omega;

@@ -31,6 +31,9 @@ impl Progress for Bar {
 }
 
 pub fn run(args: FitArgs) -> Result<()> {
+    if let Some(values) = &args.en14501 {
+        return en14501(values, args.name.as_deref());
+    }
     let mut options = args.options(String::new())?;
     options.validate()?;
     // Folders as inputs: one sample each (`many`).
@@ -212,4 +215,38 @@ fn default_name(files: &[PathBuf], klems: bool) -> Result<String> {
         })
         .collect();
     Ok(brtf_radiance::default_fit_name(&sample_names, &stems))
+}
+
+/// `brtf fit --en14501 …`: the `trans` of datasheet values, with the
+/// model's own normal-incidence values as a check.
+fn en14501(values: &brtf_fit::en14501::En14501, name: Option<&str>) -> Result<()> {
+    let args = values
+        .trans_args()
+        .map_err(|e| anyhow::anyhow!("--en14501: {e}"))?;
+    let name = match name {
+        Some(n) => brtf_radiance::identifier(n)
+            .ok_or_else(|| anyhow::anyhow!("--name {n}: not usable as a Radiance identifier"))?,
+        None => "en14501".to_string(),
+    };
+    let material = brtf_model::Material::new(brtf_model::MaterialKind::Trans, &args, None)?;
+    let bsdf = brtf_model::Bsdf::new(&material, &brtf_model::EvalOptions::default());
+    let a = brtf_model::albedo(&bsdf, glam::DVec3::Z, 1e-8);
+    let command: Vec<String> = std::env::args().collect();
+    let numbers: Vec<String> = args.iter().map(|v| format!("{v:.6}")).collect();
+    print(&format!(
+        "# brtf {}: {}\n\
+         # trans from EN 14501 normal-incidence values tau_nh={} tau_nn={} rho_nh={} spec={}\n\
+         # brtf-model at normal incidence: rho_nh={:.4} tau_nh={:.4} tau_nn={:.4}\n\
+         void trans {name}\n0\n0\n7 {}\n",
+        env!("CARGO_PKG_VERSION"),
+        command.join(" "),
+        values.tau_nh,
+        values.tau_nn,
+        values.rho_nh,
+        values.spec,
+        a.rho[1] + a.rho_spike[1],
+        a.tau[1] + a.tau_spike[1],
+        a.tau_spike[1],
+        numbers.join(" ")
+    ))
 }
