@@ -203,6 +203,101 @@ impl std::str::FromStr for IncidenceFilter {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use brtf_gonio::klems::{KlemsBand, KlemsDirection, KlemsHeader, KlemsMatrix};
+    use brtf_model::{Bsdf, EvalOptions, Material, MaterialKind};
+
+    /// A Klems Full file lit from the front whose values do not matter.
+    fn front_file() -> KlemsBsdf {
+        let basis = KlemsBasis::full();
+        let n = basis.len();
+        let matrix = |direction| KlemsMatrix {
+            band: KlemsBand::Visible,
+            direction,
+            n,
+            values: vec![0.1; n * n],
+            clipped_negative: 0,
+            line: 1,
+        };
+        KlemsBsdf {
+            source: "test".into(),
+            header: KlemsHeader::default(),
+            incident_data_structure: "Columns".into(),
+            basis,
+            matrices: vec![
+                matrix(KlemsDirection::ReflectionBack),
+                matrix(KlemsDirection::TransmissionBack),
+            ],
+        }
+    }
+
+    /// Averaging matters: for a lobe of roughness 0.05 the model averaged
+    /// over the incident and outgoing patch is far from the model at the
+    /// patch centres, and the fit's fixed pairs give the double patch
+    /// average that a dense independent quadrature gives.
+    #[test]
+    fn patch_averages_differ_from_centre_values_and_match_dense_quadrature() {
+        let file = front_file();
+        let recipe = Recipe::for_klems(MaterialKind::Trans);
+        let material = Material::new(
+            MaterialKind::Trans,
+            &[0.7, 0.7, 0.7, 0.05, 0.05, 0.5, 0.4],
+            None,
+        )
+        .unwrap();
+        let bsdf = Bsdf::new(&material, &EvalOptions::default());
+        let basis = &file.basis;
+        // Incident patch 49: the 40° ring (rings 0-4 hold 1 + 8 + 16 + 20).
+        let incident = 49;
+        let at = KlemsPatchRef {
+            side: Side::Front,
+            patch: incident,
+        };
+        let prepared = prepare_patch(&recipe, &file, at, "test").unwrap().unwrap();
+        let p_in = basis.patch(incident).unwrap();
+        assert_eq!(p_in.theta_deg, 40.0);
+        // The diagonal reflection sample (mirror) and transmission sample
+        // (straight through) are outgoing patch `incident` of each block.
+        for (sample, transmitted) in [(incident, false), (basis.len() + incident, true)] {
+            let averaged = prepared.model_value(&bsdf, sample)[1];
+            let s = &prepared.measurement.samples[sample];
+            let centre = bsdf.eval(prepared.measurement.incident_direction(), s.direction())[1];
+            // Dense quadrature: 24 × 24 strata of each patch, every pairing.
+            let lights: Vec<DVec3> = p_in
+                .stratified_directions(576, &mut Rng::new(99, 1))
+                .into_iter()
+                .map(|v| DVec3::new(-v.x, -v.y, v.z))
+                .collect();
+            let views: Vec<DVec3> = p_in
+                .stratified_directions(576, &mut Rng::new(99, 2))
+                .into_iter()
+                .map(|v| {
+                    if transmitted {
+                        DVec3::new(v.x, v.y, -v.z)
+                    } else {
+                        v
+                    }
+                })
+                .collect();
+            let mut sum = 0.0;
+            for l in lights.iter().step_by(4) {
+                for v in &views {
+                    sum += bsdf.eval(*l, *v)[1];
+                }
+            }
+            let dense = sum / (144.0 * 576.0);
+            eprintln!(
+                "transmitted {transmitted}: centre {centre:.4}, fit average {averaged:.4}, dense {dense:.4}"
+            );
+            assert!(
+                centre > 1.5 * averaged,
+                "transmitted {transmitted}: centre {centre} vs average {averaged}"
+            );
+            assert!(
+                (averaged / dense - 1.0).abs() < 0.03,
+                "transmitted {transmitted}: fit's average {averaged} vs dense {dense}"
+            );
+        }
+    }
 
     #[test]
     fn filters_parse_and_keep() {

@@ -115,7 +115,7 @@ impl Default for PatchAveraging {
     fn default() -> Self {
         PatchAveraging {
             outgoing_samples: 32,
-            incident_samples: 16,
+            incident_samples: 32,
             near_lobe_deg: 35.0,
             seed: 1,
         }
