@@ -282,3 +282,65 @@ fn en14501_values_give_a_trans_with_those_values() {
         assert!(err.contains(message), "{values}: {err}");
     }
 }
+
+/// A real fabric, both sides: every incidence of the chosen rings
+/// converges, each side is a complete fit folder whose recipe says "Klems
+/// patch averages", and the side-by-side report holds both sides' rows and
+/// the Klems-patch maps.
+#[test]
+fn real_fabric_both_sides_converge_and_are_reported_side_by_side() {
+    let tmp = temp_dir();
+    let out = tmp.path().join("mecho");
+    let printed = brtf(
+        &[
+            "fit",
+            s(&fabric("klems_aniso_high.xml")),
+            "--model",
+            "trans",
+            "--gray",
+            "--incidences",
+            "theta<=10",
+            "--out",
+            s(&out),
+        ],
+        "",
+    )
+    .ok();
+    assert!(printed.contains("(both sides)"), "{printed}");
+    for side in ["front", "back"] {
+        let dir = out.join(side);
+        for file in ["fit.json", "params.csv", "report.html"] {
+            assert!(dir.join(file).is_file(), "{side}/{file} missing");
+        }
+        let json: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("fit.json")).unwrap()).unwrap();
+        assert!(
+            json["recipe"]["patch_average"].is_object(),
+            "{side}: no patch_average"
+        );
+        let incidences = json["incidences"].as_array().unwrap();
+        assert_eq!(incidences.len(), 9, "{side}: the 0° and 10° rings");
+        for i in incidences {
+            let termination = i["termination"].to_string();
+            assert!(
+                termination.contains("Converged") || termination.contains("Orthogonal"),
+                "{side} {}: {termination}",
+                i["source"]
+            );
+        }
+        let inputs = json["provenance"]["inputs"].as_array().unwrap();
+        assert!(inputs.iter().all(|i| i["klems"]["side"] == side), "{side}");
+        // The table averages each ring over φ_in: two rows.
+        assert_eq!(json["table"]["theta_in"].as_array().unwrap().len(), 2);
+    }
+    let report = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(report.contains("front side") && report.contains("back side"));
+    assert_eq!(
+        report.matches("<tr><td>").count(),
+        18,
+        "one row per incidence and side"
+    );
+    // Two rings per side, reflection and transmission disks each.
+    assert_eq!(report.matches("<figure><svg").count(), 8);
+    assert!(!report.contains("cannot be shown"), "{report}");
+}
