@@ -14,9 +14,10 @@ use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub struct FitArgs {
-    /// Measurement files, one incidence each (.mpc or pab-opto Mountain), or
-    /// sample folders, one sample each (its .mpc and .txt files), each
-    /// fitted into OUT/<name>/.
+    /// Measurement files, one incidence each (.mpc or pab-opto Mountain); or
+    /// Klems BSDF XML files (each incident patch of a side an incidence,
+    /// docs/klems.md); or sample folders, one sample each (its .mpc and
+    /// .txt files), each fitted into OUT/<name>/.
     #[arg(required_unless_present = "en14501")]
     pub files: Vec<PathBuf>,
     /// Model to fit: plastic, metal, trans, plastic2, metal2 or trans2.
