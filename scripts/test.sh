@@ -60,7 +60,7 @@ PATH="$PWD/.venv/bin:$PATH" .venv/bin/pip install --quiet --disable-pip-version-
     --no-build-isolation --force-reinstall --no-deps ./python || python_status=$?
 if [ "$python_status" -eq 0 ]; then
     echo "== pytest python/tests"
-    BRTF_BIN="$PWD/target/debug/brtf" .venv/bin/python -m pytest -q -p no:cacheprovider python/tests \
+    BRTF_BIN="${CARGO_TARGET_DIR:-$PWD/target}/debug/brtf" .venv/bin/python -m pytest -q -p no:cacheprovider python/tests \
         || python_status=$?
     echo "== docs/python.md example"
     .venv/bin/python python/examples/golden_paper.py --out target/python-example >/dev/null \

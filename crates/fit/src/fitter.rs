@@ -373,10 +373,16 @@ impl Reported<'_> {
         let understated: Vec<StderrRatio> = params
             .iter()
             .filter_map(|p| match (p.stderr, p.stderr_robust) {
-                (Some(plain), Some(robust)) if robust > 2.0 * plain => Some(StderrRatio {
+                // A zero plain error (a parameter pinned at a bound) has no
+                // finite ratio; JSON has no infinity, so it is not listed.
+                (Some(plain), Some(robust))
+                    if plain > 0.0 && robust > 2.0 * plain && (robust / plain).is_finite() =>
+                {
+                    Some(StderrRatio {
                     param: p.name.clone(),
-                    ratio: robust / plain,
-                }),
+                        ratio: robust / plain,
+                    })
+                }
                 _ => None,
             })
             .collect();

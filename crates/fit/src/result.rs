@@ -252,9 +252,21 @@ impl FitResult {
             what: "cannot format",
             source: std::io::Error::other(e),
         })?;
+        let json = self.to_json();
+        // What is written must read back: JSON has no NaN or infinity
+        // (serde_json writes null), so a non-finite number would leave a
+        // folder no other command can read. Refuse it here instead.
+        let path = dir.join("fit.json");
+        if let Err(e) = FitResult::from_json(&json, &path) {
+            return Err(brtf_io::IoError {
+                path,
+                what: "refusing to write a fit.json that does not read back",
+                source: std::io::Error::other(e.to_string()),
+            });
+        }
         brtf_io::ensure_folder(dir)?;
         brtf_io::write_atomic(&dir.join("params.csv"), csv.as_bytes())?;
-        brtf_io::write_atomic(&dir.join("fit.json"), self.to_json().as_bytes())
+        brtf_io::write_atomic(&path, json.as_bytes())
     }
 
     /// The `fit.json` text.
