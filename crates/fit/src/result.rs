@@ -365,3 +365,26 @@ impl FitResult {
         Ok(String::from_utf8(bytes).expect("CSV of UTF-8 text is UTF-8"))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A number JSON cannot hold (serde_json writes infinity as null) is
+    /// refused before anything is written, instead of leaving a fit.json
+    /// that no command can read.
+    #[test]
+    fn a_fit_json_that_would_not_read_back_is_not_written() {
+        let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fits/alu-ggx/fit.json");
+        let mut result = FitResult::read(&shipped).expect("the shipped fit reads");
+        let dir = std::env::temp_dir().join(format!("brtf-fit-json-{}", std::process::id()));
+        result.write(&dir).expect("a finite result writes");
+        assert!(FitResult::read(&dir.join("fit.json")).is_ok());
+        std::fs::remove_dir_all(&dir).unwrap();
+        result.incidences[0].cost = f64::INFINITY;
+        let error = result.write(&dir).unwrap_err().to_string();
+        assert!(error.contains("does not read back"), "{error}");
+        assert!(!dir.join("fit.json").exists());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
