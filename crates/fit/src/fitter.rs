@@ -379,7 +379,7 @@ impl Reported<'_> {
                     if plain > 0.0 && robust > 2.0 * plain && (robust / plain).is_finite() =>
                 {
                     Some(StderrRatio {
-                    param: p.name.clone(),
+                        param: p.name.clone(),
                         ratio: robust / plain,
                     })
                 }
