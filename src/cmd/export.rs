@@ -226,19 +226,7 @@ fn run_klems(args: ExportArgs) -> Result<()> {
             .unwrap_or_else(|| result.name.clone()),
         None => result.name.clone(),
     };
-    let stem: String = name
-        .rsplit(['/', '\\'])
-        .find(|s| !s.is_empty())
-        .unwrap_or("klems")
-        .chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.') {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect();
+    let stem = klems::klems_file_stem(&name);
     options.name = name;
     let export = klems::klems_from_fit_dir(&dir, &options)
         .with_context(|| format!("exporting {} as Klems XML", dir.display()))?;

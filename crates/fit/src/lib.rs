@@ -76,7 +76,7 @@ pub use params::{MAX_ROUGHNESS, MIN_ROUGHNESS, ParamMap, Slot, Target};
 pub use problem::ResidualKind;
 pub use recipe::{
     BeamOrigin, ColourConversion, Conversion, DataUnit, PatchAveraging, PreparedMeasurement,
-    RawScale, Recipe, RecipeError, ScaleRule, WeightRule,
+    RawScale, Recipe, RecipeError, ScaleRule, SelectionOptions, WeightRule,
 };
 pub use report::{
     FitReport, FitWarning, ParamEstimate, RobustRecord, StartRecord, StderrRatio, Termination,

@@ -170,6 +170,54 @@ impl Recipe {
     }
 }
 
+/// The selection options of `brtf fit` (and the Python package's `fit`),
+/// and the one place that turns them into [`Gate`]s.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SelectionOptions {
+    /// The hemisphere kept; `None` keeps both.
+    pub hemisphere: Option<brtf_gonio::Hemisphere>,
+    /// Largest θ_out used, degrees (not for Klems patch averages).
+    pub theta_cap: f64,
+    /// Half-angle of the masked cone around the beam, degrees; 0: none
+    /// (not for Klems patch averages).
+    pub beam_mask: f64,
+    /// Drop samples below this value.
+    pub min_value: Option<f64>,
+    /// Mask the pgII sample holder's shadow.
+    pub mask_holder: bool,
+}
+
+impl SelectionOptions {
+    /// The default hemisphere for `kind`: the front for opaque models,
+    /// both (`None`) for transmitting ones.
+    pub fn default_hemisphere(kind: brtf_model::MaterialKind) -> Option<brtf_gonio::Hemisphere> {
+        (!kind.is_transmitting()).then_some(brtf_gonio::Hemisphere::Front)
+    }
+
+    /// The gates, in the order they are applied. Klems patches cover the
+    /// hemisphere to 90° and the diagonal patch holds the peak, so
+    /// `klems` data get no θ cap and no beam mask.
+    pub fn gates(&self, klems: bool) -> Vec<Gate> {
+        let mut selections = vec![Gate::Unavailable];
+        selections.extend(self.hemisphere.map(|keep| Gate::Hemisphere { keep }));
+        if !klems {
+            selections.push(Gate::ThetaCap {
+                max_deg: self.theta_cap,
+            });
+            if self.beam_mask > 0.0 {
+                selections.push(Gate::BeamMask {
+                    half_angle_deg: self.beam_mask,
+                });
+            }
+        }
+        selections.extend(self.min_value.map(|min| Gate::MinValue { min }));
+        if self.mask_holder {
+            selections.push(brtf_gonio::PGII_HOLDER_BAND);
+        }
+        selections
+    }
+}
+
 /// Where a beam integral came from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]

@@ -6,8 +6,8 @@ use crate::errors::{self, Class};
 use crate::material::{Material, parse_kind, parse_variant};
 use crate::measurement::Measurement;
 use brtf_fit::{
-    ColourConversion, FitConfig, FitReport, FitResult, FitSetOptions, Gate, Interpolation,
-    NoProgress, Recipe, ResidualKind, RobustLoss, ScaleRule, WeightRule,
+    ColourConversion, FitConfig, FitReport, FitResult, FitSetOptions, Interpolation, NoProgress,
+    Recipe, ResidualKind, RobustLoss, ScaleRule, SelectionOptions, WeightRule,
 };
 use brtf_gonio::Hemisphere;
 use brtf_gonio::klems::KlemsBasis;
@@ -151,23 +151,16 @@ impl FitKwargs {
                     ("both", None),
                 ],
             )?,
-            None if kind.is_transmitting() => None,
-            None => Some(Hemisphere::Front),
+            None => SelectionOptions::default_hemisphere(kind),
         };
-        let mut selections = vec![Gate::Unavailable];
-        selections.extend(hemisphere.map(|keep| Gate::Hemisphere { keep }));
-        selections.push(Gate::ThetaCap {
-            max_deg: self.theta_cap,
-        });
-        if self.beam_mask > 0.0 {
-            selections.push(Gate::BeamMask {
-                half_angle_deg: self.beam_mask,
-            });
+        let selections = SelectionOptions {
+            hemisphere,
+            theta_cap: self.theta_cap,
+            beam_mask: self.beam_mask,
+            min_value: self.min_value,
+            mask_holder: self.mask_holder,
         }
-        selections.extend(self.min_value.map(|min| Gate::MinValue { min }));
-        if self.mask_holder {
-            selections.push(brtf_gonio::PGII_HOLDER_BAND);
-        }
+        .gates(false);
         let mut config = FitConfig::new(kind);
         config.options.variant = parse_variant(&self.variant)?;
         config.options.fresnel_k = self.fresnel_k;
@@ -655,9 +648,10 @@ impl Fit {
                 let export = klems::klems_from_fit_dir(&folder, klems_options)
                     .map_err(|e| format!("exporting {} as Klems XML: {e}", folder.display()))?;
                 let update = FolderUpdate::amend(&folder).map_err(|e| e.to_string())?;
-                let staged = update
-                    .path()
-                    .join(format!("{}.xml", file_stem(&klems_options.name)));
+                let staged = update.path().join(format!(
+                    "{}.xml",
+                    brtf_radiance::export::klems::klems_file_stem(&klems_options.name)
+                ));
                 klems::write_klems(&staged, &export).map_err(|e| e.to_string())?;
                 let listed =
                     FitResult::read(&update.path().join("fit.json")).map_err(|e| e.to_string())?;
@@ -743,22 +737,6 @@ fn save_folder(
     files.push(out.join("fit.json").display().to_string());
     update.commit().map_err(io)?;
     Ok(files)
-}
-
-/// The Klems file's stem for a name, as `brtf export --klems` makes it.
-fn file_stem(name: &str) -> String {
-    name.rsplit(['/', '\\'])
-        .find(|s| !s.is_empty())
-        .unwrap_or("klems")
-        .chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.') {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect()
 }
 
 /// When the folder holds a `fit.json`, lists the fresh exports in it in

@@ -3,8 +3,8 @@
 use crate::cmd::material::FormulaArgs;
 use anyhow::{Result, bail};
 use brtf_fit::{
-    ColourConversion, FitConfig, FitSetOptions, Gate, Interpolation, KnownReflectance, Recipe,
-    ResidualKind, RobustLoss, ScaleRule, WeightRule,
+    ColourConversion, FitConfig, FitSetOptions, Interpolation, KnownReflectance, Recipe,
+    ResidualKind, RobustLoss, ScaleRule, SelectionOptions, WeightRule,
 };
 use brtf_gonio::Hemisphere;
 use brtf_gonio::klems::Side;
@@ -208,8 +208,7 @@ impl FitArgs {
             Some(HemisphereArg::Front) => Some(Hemisphere::Front),
             Some(HemisphereArg::Back) => Some(Hemisphere::Back),
             Some(HemisphereArg::Both) => None,
-            None if model.is_transmitting() => None,
-            None => Some(Hemisphere::Front),
+            None => SelectionOptions::default_hemisphere(model),
         };
         let klems = self.files.iter().filter(|f| is_klems(f)).count();
         if klems > 0 && klems < self.files.len() {
@@ -222,24 +221,14 @@ impl FitArgs {
         if self.patch_samples == 0 || self.patch_samples > 4096 {
             bail!("--patch-samples must be between 1 and 4096");
         }
-        let mut selections = vec![Gate::Unavailable];
-        selections.extend(hemisphere.map(|keep| Gate::Hemisphere { keep }));
-        // Klems patches cover the hemisphere to 90° and the diagonal patch
-        // holds the peak: no θ cap, no beam mask.
-        if !klems {
-            selections.push(Gate::ThetaCap {
-                max_deg: self.theta_cap,
-            });
-            if self.beam_mask > 0.0 {
-                selections.push(Gate::BeamMask {
-                    half_angle_deg: self.beam_mask,
-                });
-            }
+        let selections = SelectionOptions {
+            hemisphere,
+            theta_cap: self.theta_cap,
+            beam_mask: self.beam_mask,
+            min_value: self.min_value,
+            mask_holder: self.mask_holder,
         }
-        selections.extend(self.min_value.map(|min| Gate::MinValue { min }));
-        if self.mask_holder {
-            selections.push(brtf_gonio::PGII_HOLDER_BAND);
-        }
+        .gates(klems);
         let patch_average = klems.then(|| brtf_fit::PatchAveraging {
             outgoing_samples: self.patch_samples,
             ..Default::default()

@@ -490,3 +490,22 @@ pub fn write_klems(path: &Path, export: &KlemsExport) -> Result<(), KlemsExportE
         source: e.source,
     })
 }
+
+/// The file stem of a Klems export named `name`: its last path part, with
+/// every character but ASCII letters, digits, `_`, `-` and `.` made `_`
+/// (`klems` for an empty name). `brtf export --klems` and the Python
+/// package name their files with it.
+pub fn klems_file_stem(name: &str) -> String {
+    name.rsplit(['/', '\\'])
+        .find(|s| !s.is_empty())
+        .unwrap_or("klems")
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.') {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}
