@@ -157,9 +157,9 @@ struct Constants {
     frame_v: [f64; 3],
 }
 
-const RADIANCE: u8 = 0;
-const MANUAL2004: u8 = 1;
-const WARD1992: u8 = 2;
+pub(crate) const RADIANCE: u8 = 0;
+pub(crate) const MANUAL2004: u8 = 1;
+pub(crate) const WARD1992: u8 = 2;
 
 impl Bsdf {
     /// `f(l, v)` for every pair `(light[i], view[i])`, written to `out`

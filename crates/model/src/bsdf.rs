@@ -108,16 +108,16 @@ struct ViewCoefficients {
 pub struct Geometry {
     /// cos θ of the light once the surface faces the viewer: > 0 reflection,
     /// < 0 transmission.
-    light_cosine: f64,
+    pub(crate) light_cosine: f64,
     /// cos θ of the viewer, clamped as rtrace does.
-    view_cosine: f64,
+    pub(crate) view_cosine: f64,
     /// The lobe's normalisation (reflection) or geometry factor (transmission).
-    lobe_factor: f64,
+    pub(crate) lobe_factor: f64,
     /// Exponent numerators along û and v̂ (isotropic types use `x_u` only).
-    x_u: f64,
-    x_v: f64,
+    pub(crate) x_u: f64,
+    pub(crate) x_v: f64,
     /// Anisotropic transmission: `sqrt(|cos θ_l| / cos θ_v)` for rtrace's cut-off.
-    cutoff_factor: f64,
+    pub(crate) cutoff_factor: f64,
 }
 
 impl Bsdf {
@@ -236,6 +236,11 @@ impl Bsdf {
     /// 1/(α² + widening) of the reflected lobe along û and v̂.
     pub(crate) fn reflect_inv_width(&self) -> (f64, f64) {
         self.reflect_inv_width
+    }
+
+    /// ∂(α²_u, α²_v)/∂(a_u, a_v): `[[∂α²_u/∂a_u, ∂α²_u/∂a_v], [∂α²_v/∂a_u, ∂α²_v/∂a_v]]`.
+    pub(crate) fn width_derivatives(&self) -> [[f64; 2]; 2] {
+        self.dalpha2
     }
 
     /// α² + ω/π of the transmitted lobe along û and v̂.

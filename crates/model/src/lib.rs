@@ -31,6 +31,7 @@
 
 mod albedo;
 mod batch;
+mod batch_gradient;
 mod bsdf;
 pub mod colour;
 mod kind;
@@ -40,6 +41,7 @@ pub mod rng;
 
 pub use albedo::{Albedo, albedo, gauss_legendre_rule};
 pub use batch::{Directions, RgbBatch, exp_lane};
+pub use batch_gradient::GeometryBatch;
 pub use bsdf::{Bsdf, Geometry, Gradient, Rgb, ViewSplit};
 pub use kind::{MaterialKind, Variant};
 pub use material::{FTINY, MAX_ARGS, Material, ModelError, check_args};

@@ -2,5 +2,6 @@
 
 mod albedo;
 mod batch;
+mod batch_gradient;
 mod bsdf;
 mod oracle;
