@@ -5,6 +5,7 @@
 
 use crate::config::{FitConfig, FitError, RobustLoss};
 use crate::data::IncidenceData;
+use crate::pair_geometry::PairGeometry;
 use crate::params::{ParamMap, Target};
 use crate::prepare;
 use crate::problem::Block;
@@ -14,9 +15,11 @@ use crate::report::{
 use crate::robust;
 use crate::solve::{Solved, Solver, Stage};
 use crate::uncertainty::standard_errors;
+use brtf_model::{Bsdf, Material};
 use glam::DVec3;
 use nalgebra::DVector;
 use rayon::prelude::*;
+use std::borrow::Cow;
 use std::time::Instant;
 
 /// Samples per start in the multi-start phase (every k-th sample, plus
@@ -29,6 +32,9 @@ const BRIGHT_SAMPLES: usize = 250;
 const POLISH_SAMPLES: usize = 2000;
 /// Multi-start ends polished and compared on every sample.
 const CANDIDATES: usize = 3;
+/// Most patch pairs whose geometry a fit keeps (48 bytes each): one Klems
+/// incidence has ~50 000.
+const GEOMETRY_CACHE_PAIRS: usize = 2_000_000;
 /// Robust reweighting stops when no parameter moves by more than this
 /// (relative) in a round...
 const IRLS_TOLERANCE: f64 = 1e-6;
@@ -66,6 +72,7 @@ fn fit_many(
         blocks.push(scan.block);
         stats.push(scan.stats);
     }
+    attach_pair_geometry(&mut blocks, config)?;
     let n_points: usize = blocks.iter().map(Block::len).sum();
     // Large enough to polish the best start on a subsample first.
     let polish = n_points > 2 * POLISH_SAMPLES;
@@ -231,6 +238,37 @@ fn fit_many(
         started,
     };
     report.build(&solver, &blocks, solved)
+}
+
+/// Patch-averaged blocks get their pairs' geometry computed once, unless
+/// it would take more memory than [`GEOMETRY_CACHE_PAIRS`] pairs' worth.
+fn attach_pair_geometry(blocks: &mut [Block<'_>], config: &FitConfig) -> Result<(), FitError> {
+    let pairs: usize = blocks
+        .iter()
+        .filter_map(|b| b.pairs.as_ref())
+        .map(|p| p.lights.len())
+        .sum();
+    if pairs == 0 || pairs > GEOMETRY_CACHE_PAIRS {
+        return Ok(());
+    }
+    // The geometry does not depend on the arguments: any valid set will do.
+    let args = vec![0.5; config.kind.n_args()];
+    let material = Material::new(
+        config.kind,
+        &args,
+        Some(DVec3::from_array(config.orientation)),
+    )
+    .map_err(|e| FitError::Failed {
+        origin: "patch pairs".into(),
+        reason: e.to_string(),
+    })?;
+    let bsdf = Bsdf::new(&material, &config.options);
+    blocks.par_iter_mut().for_each(|b| {
+        if let Some(p) = &b.pairs {
+            b.pair_geometry = Some(Cow::Owned(PairGeometry::new(p, &bsdf)));
+        }
+    });
+    Ok(())
 }
 
 /// Polishes each candidate on `polish` (when given; a candidate whose

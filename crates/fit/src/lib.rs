@@ -35,6 +35,7 @@ mod diagnose;
 pub mod en14501;
 mod fitter;
 pub mod klems;
+mod pair_geometry;
 mod params;
 mod prepare;
 mod problem;
@@ -83,7 +84,8 @@ pub use report::{
 };
 pub use result::{FIT_JSON_SCHEMA, FitResult, InputFile, Provenance, ReadFitError, SetWarning};
 pub use set::{
-    FitSetError, FitSetOptions, KlemsOptions, NoProgress, Progress, fit_set, prepare_input,
+    FitSetError, FitSetOptions, FittedSet, KlemsOptions, NoProgress, Progress, fit_set,
+    fit_set_with_data, prepare_input,
 };
 pub use summary::summary;
 pub use table::{Interpolation, ParamTable, TableError, TableLookup};

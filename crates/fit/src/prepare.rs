@@ -174,6 +174,7 @@ pub(crate) fn scan<'a>(
             light,
             samples: Cow::Borrowed(&d.samples),
             pairs: d.patch_pairs.as_deref().map(Cow::Borrowed),
+            pair_geometry: None,
             weight_scale: if unit_weights {
                 1.0
             } else {
@@ -252,7 +253,14 @@ pub(crate) fn subsample<'a>(b: &Block<'_>, target: usize, bright: f64) -> Block<
     Block {
         light: b.light,
         samples: Cow::Owned(samples),
-        pairs: b.pairs.as_ref().map(|p| Cow::Owned(p.select(kept))),
+        pairs: b
+            .pairs
+            .as_ref()
+            .map(|p| Cow::Owned(p.select(kept.iter().copied()))),
+        pair_geometry: b
+            .pair_geometry
+            .as_ref()
+            .map(|g| Cow::Owned(g.select(kept.iter().copied()))),
         weight_scale: b.weight_scale,
         unit_weights: b.unit_weights,
         multipliers: Some(multipliers),
@@ -321,19 +329,26 @@ pub(crate) fn starting_points(
         })
         .expect("at least one incidence");
     let f = features(reference);
-    let alpha0 = (0.5 * f.width).clamp(MIN_ROUGHNESS * 2.0, 0.5);
+    // Starts below a raised roughness bound (Klems fits) would all start
+    // at the bound: one start there is enough.
+    let lowest = config.min_roughness.max(MIN_ROUGHNESS);
+    let alpha0 = (0.5 * f.width).clamp(MIN_ROUGHNESS * 2.0, 0.5).max(lowest);
     let mut roughs: Vec<[f64; 2]> = vec![[alpha0, alpha0]];
     if config.multistart {
-        let grid = [0.01, 0.03, 0.08, 0.2, 0.4];
+        let grid = [0.01_f64, 0.03, 0.08, 0.2, 0.4];
         if config.kind.is_anisotropic() {
-            for &a in &[0.02, 0.08, 0.25] {
-                for &b in &[0.02, 0.08, 0.25] {
-                    roughs.push([a, b]);
+            for &a in &[0.02_f64, 0.08, 0.25] {
+                for &b in &[0.02_f64, 0.08, 0.25] {
+                    let start = [a.max(lowest), b.max(lowest)];
+                    if !roughs.contains(&start) {
+                        roughs.push(start);
+                    }
                 }
             }
         } else {
             for &a in &grid {
-                if (a / alpha0).ln().abs() > 0.3 {
+                let a = a.max(lowest);
+                if roughs.iter().all(|r| (a / r[0]).ln().abs() > 0.3) {
                     roughs.push([a, a]);
                 }
             }

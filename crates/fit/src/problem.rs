@@ -3,8 +3,9 @@
 //! in the unconstrained coordinates of [`ParamMap`].
 
 use crate::data::{FitSample, PatchPairs};
+use crate::pair_geometry::PairGeometry;
 use crate::params::{ParamMap, Target};
-use brtf_model::{Bsdf, EvalOptions, Gradient, Material};
+use brtf_model::{Bsdf, EvalOptions, Geometry, Gradient, Material};
 use glam::DVec3;
 use levenberg_marquardt::LeastSquaresProblem;
 use nalgebra::{DMatrix, DVector, Dyn, Owned};
@@ -44,6 +45,9 @@ pub(crate) struct Block<'a> {
     /// value is averaged over (then `light` and the samples' views are
     /// not used by the kernel).
     pub pairs: Option<Cow<'a, PatchPairs>>,
+    /// The pairs' geometry, computed once (see [`PairGeometry`]); without
+    /// it the kernel computes it from `pairs` on every pass.
+    pub pair_geometry: Option<Cow<'a, PairGeometry>>,
     /// √(weight) of sample i is `√max(wᵢ, 0) · weight_scale` (or
     /// `weight_scale` alone with `unit_weights`), times `multipliers[i]`
     /// when a robust loss has reweighted the samples or a subsample stands
@@ -347,9 +351,10 @@ impl Kernel<'_> {
         let mut sum_rel = 0.0;
         for i in start..end {
             let s = &block.samples[i];
-            let f = match &block.pairs {
-                Some(pairs) => pairs.average(&self.bsdf, i),
-                None => self.bsdf.eval(block.light, s.view),
+            let f = match (&block.pair_geometry, &block.pairs) {
+                (Some(geometry), _) => self.average(geometry.of(i)),
+                (None, Some(pairs)) => pairs.average(&self.bsdf, i),
+                (None, None) => self.bsdf.eval(block.light, s.view),
             };
             for ch in 0..channels {
                 let row = i * channels + ch;
@@ -379,9 +384,12 @@ impl Kernel<'_> {
         let mut sum_rel = 0.0;
         for i in start..end {
             let s = &block.samples[i];
-            let f = match &block.pairs {
-                Some(pairs) => self.average_with_gradient(pairs, i, &mut grad),
-                None => self.value_with_gradient(block.light, s.view, &mut grad),
+            let f = match (&block.pair_geometry, &block.pairs) {
+                (Some(geometry), _) => {
+                    self.geometry_average_with_gradient(geometry.of(i), &mut grad)
+                }
+                (None, Some(pairs)) => self.average_with_gradient(pairs, i, &mut grad),
+                (None, None) => self.value_with_gradient(block.light, s.view, &mut grad),
             };
             for ch in 0..channels {
                 let row = i * channels + ch;
@@ -461,6 +469,48 @@ impl Kernel<'_> {
                 out[c] = total[c] * inverse;
             }
         }
+        sum.map(|s| s * inverse)
+    }
+
+    /// [`Kernel::average_with_gradient`] on pairs whose geometry was
+    /// computed beforehand.
+    fn geometry_average_with_gradient(&self, pairs: &[Geometry], grad: &mut Gradient) -> [f64; 3] {
+        let mut sum = [0.0; 3];
+        let mut sum_grad = Gradient::default();
+        for g in pairs {
+            let f = if self.channels == 1 {
+                self.bsdf.eval_geometry_channels_with_gradient::<1>(g, grad)
+            } else {
+                self.bsdf.eval_geometry_with_gradient(g, grad)
+            };
+            for c in 0..3 {
+                sum[c] += f[c];
+            }
+            for (total, d) in sum_grad.d.iter_mut().zip(&grad.d) {
+                for c in 0..3 {
+                    total[c] += d[c];
+                }
+            }
+        }
+        let inverse = 1.0 / pairs.len().max(1) as f64;
+        for (out, total) in grad.d.iter_mut().zip(&sum_grad.d) {
+            for c in 0..3 {
+                out[c] = total[c] * inverse;
+            }
+        }
+        sum.map(|s| s * inverse)
+    }
+
+    /// The BSDF averaged over pairs whose geometry was computed beforehand.
+    fn average(&self, pairs: &[Geometry]) -> [f64; 3] {
+        let mut sum = [0.0; 3];
+        for g in pairs {
+            let f = self.bsdf.eval_geometry(g);
+            for c in 0..3 {
+                sum[c] += f[c];
+            }
+        }
+        let inverse = 1.0 / pairs.len().max(1) as f64;
         sum.map(|s| s * inverse)
     }
 

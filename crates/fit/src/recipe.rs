@@ -586,10 +586,15 @@ impl PreparedMeasurement {
                 .collect(),
             gates: self.gates.clone(),
             weighting: self.weighting,
-            patch_pairs: self
-                .patch_pairs
-                .as_ref()
-                .map(|pairs| std::sync::Arc::new(pairs.select(self.fitted().map(|(i, _)| i)))),
+            // Shared, not copied, when every sample is fitted: a Klems
+            // side's pairs take hundreds of MB.
+            patch_pairs: self.patch_pairs.as_ref().map(|pairs| {
+                if self.fitted_count() == pairs.len() {
+                    std::sync::Arc::clone(pairs)
+                } else {
+                    std::sync::Arc::new(pairs.select(self.fitted().map(|(i, _)| i)))
+                }
+            }),
         }
     }
 }
