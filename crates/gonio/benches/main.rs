@@ -52,6 +52,19 @@ fn geometry(c: &mut Criterion) {
     group.bench_function("solid_angles_golden_paper_127k", |b| {
         b.iter(|| brtf_gonio::compute_solid_angles(black_box(&m.samples)))
     });
+    // The cells alone on golden_paper's projected directions: brtf's own
+    // triangulation against the delaunator-based reference it replaced.
+    let projected: Vec<[f64; 2]> = m
+        .samples
+        .iter()
+        .map(|s| brtf_gonio::solid_angle::project(s.theta_deg, s.phi_deg, s.hemisphere()))
+        .collect();
+    group.bench_function("disk_voronoi_golden_paper_127k", |b| {
+        b.iter(|| brtf_gonio::solid_angle::disk_voronoi_areas(black_box(&projected)))
+    });
+    group.bench_function("disk_voronoi_golden_paper_127k_reference", |b| {
+        b.iter(|| brtf_gonio::solid_angle::reference_disk_voronoi_areas(black_box(&projected)))
+    });
     // A ring layout of the same size (212 rings x 600 azimuths to 85°):
     // the ring path.
     let rings: Vec<brtf_gonio::Sample> = (0..212)

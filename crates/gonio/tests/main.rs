@@ -19,4 +19,5 @@ mod solid_angle;
 mod solid_angle_paths;
 mod summary;
 mod synth;
+mod voronoi_fast_path;
 mod write;

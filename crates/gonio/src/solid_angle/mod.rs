@@ -24,6 +24,7 @@
 //! equally. The result is deterministic and independent of the sample
 //! order.
 
+mod delaunay;
 mod rings;
 mod voronoi;
 
@@ -31,7 +32,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::measurement::{Hemisphere, Measurement, Sample};
 
-pub use voronoi::{DISK_RADIUS, disk_polygon_area, disk_voronoi_areas, project};
+pub use voronoi::{
+    DISK_RADIUS, disk_polygon_area, disk_voronoi_areas, project, reference_disk_voronoi_areas,
+};
 
 /// Where a set of solid angles came from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]

@@ -21,13 +21,25 @@
 //! partition, so a constant integrates exactly and smooth functions to
 //! quadrature accuracy. Coincident directions (after rounding the projected
 //! coordinates to 2⁻³⁰) share one cell equally. The result is
-//! deterministic and independent of the sample order: points are sorted by
-//! their projected coordinates before the triangulation.
+//! deterministic and independent of the sample order: points are sorted
+//! (by a Hilbert-curve key, then by their coordinates) before the
+//! triangulation.
+//!
+//! The triangulation is our own incremental Delaunay in Hilbert order
+//! (module `delaunay`), which is several times faster than `delaunator` on
+//! the real scans' long near-collinear paths. The Voronoi diagram does not
+//! depend on the triangulation method, so both give the same cells up to
+//! rounding; [`reference_disk_voronoi_areas`] keeps the former
+//! delaunator-based computation as the reference the tests compare with,
+//! and as the fallback for points the fast path does not accept (outside
+//! radius 2√2 or not finite).
 
 use std::collections::HashMap;
 
 use delaunator::{EMPTY, Point, next_halfedge, triangulate};
+use rayon::prelude::*;
 
+use super::delaunay::{self, NONE, Triangulation};
 use crate::measurement::Hemisphere;
 
 /// Radius of the equal-area disk that one hemisphere maps to (√2).
@@ -44,7 +56,8 @@ const GHOSTS: usize = 32;
 /// all valid and in `hemisphere`.
 pub(crate) fn hemisphere_areas(directions: &[(f64, f64)], hemisphere: Hemisphere) -> Vec<f64> {
     let points: Vec<[f64; 2]> = directions
-        .iter()
+        .par_iter()
+        .with_min_len(4096)
         .map(|&(theta, phi)| project(theta, phi, hemisphere))
         .collect();
     disk_voronoi_areas(&points)
@@ -66,9 +79,195 @@ fn snap(v: f64) -> f64 {
     (v / GRID).round() * GRID
 }
 
+/// Points farther than this from the centre go to the reference path: the
+/// fast path needs every point well inside the ghost ring (whose inner
+/// radius is 3√2 cos(π/32) ≈ 4.2).
+const FAST_PATH_RADIUS: f64 = 2.0 * DISK_RADIUS;
+
 /// Areas of the Voronoi cells of `points` clipped to the disk of radius
 /// [`DISK_RADIUS`]. Coincident points share their cell equally.
 pub fn disk_voronoi_areas(points: &[[f64; 2]]) -> Vec<f64> {
+    let n = points.len();
+    if n == 0 {
+        return Vec::new();
+    }
+    let accepted = points.iter().all(|p| {
+        p[0].is_finite()
+            && p[1].is_finite()
+            && p[0] * p[0] + p[1] * p[1] <= FAST_PATH_RADIUS * FAST_PATH_RADIUS
+    });
+    if !accepted || n >= (u32::MAX / 8) as usize {
+        return reference_disk_voronoi_areas(points);
+    }
+
+    // Spatial order, with coincident points next to each other.
+    let order = hilbert_order(points);
+    // The triangulation's vertices: the ghost ring, then one per distinct
+    // point in Hilbert order; `group_of[i]` is point i's cell.
+    let mut vertices: Vec<[f64; 2]> = Vec::with_capacity(GHOSTS + n);
+    vertices.extend(ghost_ring());
+    let mut group_of = vec![0u32; n];
+    let mut group_size: Vec<u32> = Vec::with_capacity(n);
+    for (pos, &i) in order.iter().enumerate() {
+        let p = points[i as usize];
+        if pos == 0 || points[order[pos - 1] as usize] != p {
+            vertices.push(p);
+            group_size.push(0);
+        }
+        let g = group_size.len() - 1;
+        group_of[i as usize] = g as u32;
+        group_size[g] += 1;
+    }
+    let Some(tri) =
+        delaunay::triangulate_in_polygon(&vertices, GHOSTS, GHOSTS as u32..vertices.len() as u32)
+    else {
+        return reference_disk_voronoi_areas(points);
+    };
+    let Some(cell_areas) = cell_areas(&vertices, &tri) else {
+        return reference_disk_voronoi_areas(points);
+    };
+    group_of
+        .iter()
+        .map(|&g| cell_areas[g as usize] / group_size[g as usize] as f64)
+        .collect()
+}
+
+/// The indices of `points` (all finite) in Hilbert-curve order over their
+/// bounding box, ties (the same curve cell) broken by the coordinates, so
+/// that coincident points are adjacent and the order does not depend on the
+/// input order except among coincident points.
+fn hilbert_order(points: &[[f64; 2]]) -> Vec<u32> {
+    const LEVELS: u32 = 16;
+    let side = ((1u32 << LEVELS) - 1) as f64;
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in points {
+        for k in 0..2 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let scale = side / (hi[0] - lo[0]).max(hi[1] - lo[1]).max(f64::MIN_POSITIVE);
+    let mut keyed: Vec<u64> = points
+        .par_iter()
+        .with_min_len(4096)
+        .enumerate()
+        .map(|(i, p)| {
+            let x = ((p[0] - lo[0]) * scale) as u32;
+            let y = ((p[1] - lo[1]) * scale) as u32;
+            (hilbert_index(x, y, LEVELS) << 32) | i as u64
+        })
+        .collect();
+    keyed.par_sort_unstable();
+    let mut order: Vec<u32> = keyed.iter().map(|&k| k as u32).collect();
+    // Points in the same curve cell: order them by their coordinates.
+    let mut start = 0;
+    while start < keyed.len() {
+        let key = keyed[start] >> 32;
+        let mut end = start + 1;
+        while end < keyed.len() && keyed[end] >> 32 == key {
+            end += 1;
+        }
+        if end - start > 1 {
+            order[start..end].sort_unstable_by(|&a, &b| {
+                let (pa, pb) = (points[a as usize], points[b as usize]);
+                pa[0].total_cmp(&pb[0]).then(pa[1].total_cmp(&pb[1]))
+            });
+        }
+        start = end;
+    }
+    order
+}
+
+/// Position of the cell `(x, y)` along the Hilbert curve that fills a
+/// `2^levels` square.
+fn hilbert_index(mut x: u32, mut y: u32, levels: u32) -> u64 {
+    let n = 1u32 << levels;
+    let mut d = 0u64;
+    let mut s = n / 2;
+    while s > 0 {
+        let rx = u32::from(x & s != 0);
+        let ry = u32::from(y & s != 0);
+        d += u64::from(s) * u64::from(s) * u64::from((3 * rx) ^ ry);
+        if ry == 0 {
+            if rx == 1 {
+                x = n - 1 - x;
+                y = n - 1 - y;
+            }
+            std::mem::swap(&mut x, &mut y);
+        }
+        s /= 2;
+    }
+    d
+}
+
+/// The ghost points closing the outer cells, counter-clockwise.
+fn ghost_ring() -> impl Iterator<Item = [f64; 2]> {
+    let ghost_radius = 3.0 * DISK_RADIUS;
+    (0..GHOSTS).map(move |k| {
+        let a = std::f64::consts::TAU * k as f64 / GHOSTS as f64;
+        [ghost_radius * a.cos(), ghost_radius * a.sin()]
+    })
+}
+
+/// Disk-clipped Voronoi cell areas of the non-ghost vertices, in order, or
+/// `None` if a cell does not close (never seen: every such vertex is inside
+/// the ghost ring).
+fn cell_areas(vertices: &[[f64; 2]], tri: &Triangulation) -> Option<Vec<f64>> {
+    let circumcenters: Vec<[f64; 2]> = tri
+        .triangles
+        .par_chunks_exact(3)
+        .with_min_len(4096)
+        .map(|t| {
+            circumcenter(
+                vertices[t[0] as usize],
+                vertices[t[1] as usize],
+                vertices[t[2] as usize],
+            )
+        })
+        .collect();
+    // One halfedge ending at each vertex.
+    let mut incoming = vec![NONE; vertices.len()];
+    for (e, _) in tri.triangles.iter().enumerate() {
+        let e = e as u32;
+        incoming[tri.triangles[delaunay::next(e) as usize] as usize] = e;
+    }
+    let steps = tri.triangles.len();
+    incoming[GHOSTS..]
+        .par_iter()
+        .with_min_len(2048)
+        .map_init(
+            || Vec::with_capacity(16),
+            |polygon: &mut Vec<[f64; 2]>, &start| {
+                if start == NONE {
+                    return None;
+                }
+                polygon.clear();
+                let mut e = start;
+                for _ in 0..steps {
+                    polygon.push(circumcenters[e as usize / 3]);
+                    let twin = tri.halfedges[delaunay::next(e) as usize];
+                    if twin == NONE {
+                        return None;
+                    }
+                    e = twin;
+                    if e == start {
+                        return Some(disk_polygon_area(polygon, DISK_RADIUS).abs());
+                    }
+                }
+                None
+            },
+        )
+        .collect()
+}
+
+/// Areas of the Voronoi cells of `points` clipped to the disk of radius
+/// [`DISK_RADIUS`]. Coincident points share their cell equally.
+///
+/// The delaunator-based computation this crate used before its own
+/// triangulation: the same cells up to rounding, several times slower.
+/// Kept as the reference for tests and benchmarks, and as the fallback of
+/// [`disk_voronoi_areas`].
+pub fn reference_disk_voronoi_areas(points: &[[f64; 2]]) -> Vec<f64> {
     let n = points.len();
     let mut areas = vec![0.0; n];
     if n == 0 {
