@@ -108,12 +108,32 @@ struct Input {
     prepared: PreparedMeasurement,
 }
 
+/// A fit set and the data it fitted.
+#[derive(Debug, Clone)]
+pub struct FittedSet {
+    /// The fit.
+    pub result: FitResult,
+    /// The fitted data of each incidence, as [`prepare_input`] would make
+    /// them again from the file (`prepared[k]` belongs to
+    /// `result.incidences[k]`), so that plots need not read the files again.
+    pub prepared: Vec<PreparedMeasurement>,
+}
+
 /// Reads, prepares and fits every file; see the module docs.
 pub fn fit_set(
     paths: &[PathBuf],
     options: &FitSetOptions,
     progress: &dyn Progress,
 ) -> Result<FitResult, FitSetError> {
+    fit_set_with_data(paths, options, progress).map(|set| set.result)
+}
+
+/// [`fit_set`], keeping the fitted data.
+pub fn fit_set_with_data(
+    paths: &[PathBuf],
+    options: &FitSetOptions,
+    progress: &dyn Progress,
+) -> Result<FittedSet, FitSetError> {
     if paths.is_empty() {
         return Err(FitSetError::NoInputs);
     }
@@ -139,7 +159,18 @@ pub fn fit_set(
     config.free_scale |= free_count > 0;
 
     let mut warnings = Vec::new();
-    let (mut reports, mut global) = fit_all(&inputs, &config, progress)?;
+    // The adequacy diagnostics' second fit (another residual kind) needs
+    // only the data: unless `--rho` changes the data after the main fits,
+    // it runs beside them.
+    let other_early = options.adequacy && options.known_reflectance.is_none();
+    let steps = fit_all_steps(inputs.len()) + if other_early { inputs.len() } else { 0 };
+    progress.begin(steps as u64);
+    let (main, early) = rayon::join(
+        || fit_all(&inputs, &config, progress),
+        || other_early.then(|| other_fits(&inputs, &config, progress)),
+    );
+    progress.end();
+    let (mut reports, mut global) = main?;
 
     // A known reflectance turns a free-scale fit absolute: the data's own
     // ρ_dh at that incidence (measured directions from the data, the rest
@@ -173,11 +204,23 @@ pub fn fit_set(
             k,
         };
         config.free_scale = false;
-        (reports, global) = fit_all(&inputs, &config, progress)?;
+        progress.begin(fit_all_steps(inputs.len()) as u64);
+        let refit = fit_all(&inputs, &config, progress);
+        progress.end();
+        (reports, global) = refit?;
     }
 
     if options.adequacy {
-        assess(&inputs, &mut reports, &config, progress)?;
+        let others = match early {
+            Some(others) => others,
+            None => {
+                progress.begin(inputs.len() as u64);
+                let others = other_fits(&inputs, &config, progress);
+                progress.end();
+                others
+            }
+        };
+        assess(&inputs, &mut reports, &config, others);
     }
 
     // Klems incidences come in θ rings of azimuth patches: the table
@@ -201,14 +244,15 @@ pub fn fit_set(
             None
         }
     };
-    Ok(FitResult {
+    let (files, prepared) = inputs.into_iter().map(|i| (i.file, i.prepared)).unzip();
+    let result = FitResult {
         schema: FIT_JSON_SCHEMA,
         name: options.name.clone(),
         provenance: Provenance {
             brtf_version: env!("CARGO_PKG_VERSION").into(),
             command_line: options.command_line.clone(),
             created: brtf_io::utc_now_rfc3339(),
-            inputs: inputs.into_iter().map(|i| i.file).collect(),
+            inputs: files,
         },
         recipe,
         config,
@@ -218,7 +262,8 @@ pub fn fit_set(
         interpolation: options.interpolation,
         warnings,
         outputs: Vec::new(),
-    })
+    };
+    Ok(FittedSet { result, prepared })
 }
 
 /// Reads one file and applies the recipe: one input, or for a Klems file
@@ -332,28 +377,37 @@ fn instrument_scale(
     }
 }
 
-/// The adequacy diagnostics of every incidence, with the fit made again
-/// with another residual kind, and their warnings.
-fn assess(
+/// Every incidence fitted again with the other residual kind (see
+/// [`diagnose::other_residual`]) and no robust loss: the adequacy
+/// diagnostics' second fit. `None` where that fit fails.
+fn other_fits(
     inputs: &[Input],
-    reports: &mut [FitReport],
     config: &FitConfig,
     progress: &dyn Progress,
-) -> Result<(), FitSetError> {
-    let other = diagnose::other_residual(config.residual);
+) -> Vec<Option<FitReport>> {
     let mut other_config = config.clone();
-    other_config.residual = other;
+    other_config.residual = diagnose::other_residual(config.residual);
     other_config.loss = crate::RobustLoss::None;
-    progress.begin(inputs.len() as u64);
-    let others: Vec<Option<FitReport>> = inputs
+    inputs
         .par_iter()
         .map(|i| {
             let r = fit_incidence(&i.prepared.incidence_data(), &other_config).ok();
             progress.advance();
             r
         })
-        .collect();
-    progress.end();
+        .collect()
+}
+
+/// The adequacy diagnostics of every incidence, with the fits made with
+/// the other residual kind (`others`, from [`other_fits`] on the same
+/// data), and their warnings.
+fn assess(
+    inputs: &[Input],
+    reports: &mut [FitReport],
+    config: &FitConfig,
+    others: Vec<Option<FitReport>>,
+) {
+    let other = diagnose::other_residual(config.residual);
     for ((input, report), other_fit) in inputs.iter().zip(reports.iter_mut()).zip(others) {
         let Some(mut adequacy) = diagnose::diagnose(&input.prepared, report, config) else {
             continue;
@@ -362,17 +416,21 @@ fn assess(
         report.warnings.extend(diagnose::warnings(&adequacy));
         report.adequacy = Some(adequacy);
     }
-    Ok(())
 }
 
-/// Fits every incidence and all of them at once, in parallel.
+/// The progress steps of [`fit_all`] on `incidences` incidences.
+fn fit_all_steps(incidences: usize) -> usize {
+    incidences + 1
+}
+
+/// Fits every incidence and all of them at once, in parallel. The caller
+/// begins and ends the progress ([`fit_all_steps`] steps).
 fn fit_all(
     inputs: &[Input],
     config: &FitConfig,
     progress: &dyn Progress,
 ) -> Result<(Vec<FitReport>, FitReport), FitSetError> {
     let data: Vec<IncidenceData> = inputs.iter().map(|i| i.prepared.incidence_data()).collect();
-    progress.begin(data.len() as u64 + 1);
     let (reports, global) = rayon::join(
         || {
             data.par_iter()
@@ -393,7 +451,6 @@ fn fit_all(
             Some(r)
         },
     );
-    progress.end();
     let reports = reports.into_iter().collect::<Result<Vec<_>, _>>()?;
     let global = match global {
         Some(g) => g?,

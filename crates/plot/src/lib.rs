@@ -49,7 +49,7 @@ pub mod report;
 pub use error::PlotError;
 pub use klems::klems_sides_report;
 
-use brtf_fit::FitResult;
+use brtf_fit::{FitResult, PreparedMeasurement};
 use charts::cut::{CutChart, CutsChart};
 use charts::map::MapChart;
 use charts::theta::{ParamsChart, RhoChart, RmsChart};
@@ -165,6 +165,28 @@ pub fn write_plots(
     result: &FitResult,
     options: &PlotOptions,
 ) -> Result<Written, PlotError> {
+    plot(dir, result, &[], options)
+}
+
+/// [`write_plots`] on the data the fit fitted (`prepared[k]` for
+/// `result.incidences[k]`, as [`brtf_fit::fit_set_with_data`] returns
+/// them) instead of reading and preparing the measurement files again.
+/// Incidences without an entry in `prepared` are read from their files.
+pub fn write_plots_with_data(
+    dir: &Path,
+    result: &FitResult,
+    prepared: &[PreparedMeasurement],
+    options: &PlotOptions,
+) -> Result<Written, PlotError> {
+    plot(dir, result, prepared, options)
+}
+
+fn plot(
+    dir: &Path,
+    result: &FitResult,
+    prepared: &[PreparedMeasurement],
+    options: &PlotOptions,
+) -> Result<Written, PlotError> {
     if result.incidences.is_empty() {
         return Err(PlotError::NoIncidences);
     }
@@ -172,7 +194,10 @@ pub fn write_plots(
     let tags = prepare::tags(&result.incidences);
     let loaded: Vec<Result<Incidence, String>> = (0..result.incidences.len())
         .into_par_iter()
-        .map(|k| prepare::load(result, k, tags[k].clone(), dir, &options.search_dirs))
+        .map(|k| match prepared.get(k) {
+            Some(data) => prepare::from_prepared(result, k, tags[k].clone(), data),
+            None => prepare::load(result, k, tags[k].clone(), dir, &options.search_dirs),
+        })
         .collect();
     let mut warnings: Vec<String> = Vec::new();
     for l in &loaded {

@@ -191,6 +191,36 @@ pub fn load(
         ));
     }
     let prepared = rebuild(&result.recipe, input, &bytes, &path)?;
+    build(result, index, tag, input, &prepared, warnings)
+}
+
+/// Builds incidence `index` of `result` from the data the fit itself
+/// fitted (`prepared`, from [`brtf_fit::fit_set_with_data`]), without
+/// reading the file again. The same checks as [`load`] apply.
+pub fn from_prepared(
+    result: &FitResult,
+    index: usize,
+    tag: String,
+    prepared: &PreparedMeasurement,
+) -> Result<Incidence, String> {
+    let report = &result.incidences[index];
+    let input = result
+        .input_of(index)
+        .ok_or_else(|| format!("{}: not listed in the provenance", report.source))?;
+    build(result, index, tag, input, prepared, Vec::new())
+}
+
+/// The incidence `index` of `result` on its fitted data `prepared` (read
+/// from `input`), with the `warnings` found so far.
+fn build(
+    result: &FitResult,
+    index: usize,
+    tag: String,
+    input: &InputFile,
+    prepared: &PreparedMeasurement,
+    mut warnings: Vec<String>,
+) -> Result<Incidence, String> {
+    let report = &result.incidences[index];
     let channels = prepared.channels();
     let unit = prepared.conversion.unit();
     let material = result

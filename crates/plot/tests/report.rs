@@ -161,3 +161,57 @@ fn no_incidence_is_an_error_and_a_bad_fit_json_names_its_line() {
         .to_string();
     assert!(err.contains("cannot read"), "{err}");
 }
+
+#[test]
+fn the_fits_own_data_draw_the_same_plots_as_the_files() {
+    let kind = brtf_model::MaterialKind::Metal;
+    let options = brtf_fit::FitSetOptions {
+        name: "alu-ggx".into(),
+        config: brtf_fit::FitConfig::new(kind),
+        recipe: brtf_fit::Recipe::for_kind(kind),
+        known_reflectance: None,
+        interpolation: Default::default(),
+        command_line: vec!["test".into()],
+        adequacy: false,
+        klems: Default::default(),
+    };
+    let mut files: Vec<_> = std::fs::read_dir(repo().join("data/alu-ggx"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "mpc"))
+        .collect();
+    files.sort();
+    let set = brtf_fit::fit_set_with_data(&files, &options, &brtf_fit::NoProgress).expect("fits");
+    assert_eq!(set.prepared.len(), set.result.incidences.len());
+    let from_files = tempfile::tempdir().unwrap();
+    let from_fit = tempfile::tempdir().unwrap();
+    let plot_options = PlotOptions::default();
+    let read = brtf_plot::write_plots(from_files.path(), &set.result, &plot_options).unwrap();
+    let handed = brtf_plot::write_plots_with_data(
+        from_fit.path(),
+        &set.result,
+        &set.prepared,
+        &plot_options,
+    )
+    .unwrap();
+    assert!(read.warnings.is_empty() && handed.warnings.is_empty());
+    assert_eq!(read.files.len(), handed.files.len());
+    // Maps and cuts of all five incidences, the overview charts, the report.
+    assert!(read.files.len() > 2 * 2 * 5, "{:?}", read.files);
+    for (a, b) in read.files.iter().zip(&handed.files) {
+        let relative = a.strip_prefix(from_files.path()).unwrap();
+        assert_eq!(relative, b.strip_prefix(from_fit.path()).unwrap());
+        let (a, b) = (std::fs::read(a).unwrap(), std::fs::read(b).unwrap());
+        if relative.ends_with("report.html") {
+            // The report names its folder.
+            let text = |bytes: Vec<u8>, dir: &std::path::Path| {
+                String::from_utf8(bytes)
+                    .unwrap()
+                    .replace(&dir.display().to_string(), "DIR")
+            };
+            assert_eq!(text(a, from_files.path()), text(b, from_fit.path()));
+        } else {
+            assert!(a == b, "{} differs", relative.display());
+        }
+    }
+}

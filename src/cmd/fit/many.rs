@@ -167,9 +167,22 @@ fn fit_one(
     options.name = sample.name.clone();
     let update = FolderUpdate::fresh(&sample.out)?;
     brtf_io::check_replaceable(update.target(), &sample.files, args.force)?;
-    let mut result = brtf_fit::fit_set(&sample.files, &options, bar)?;
+    let brtf_fit::FittedSet {
+        mut result,
+        prepared,
+    } = brtf_fit::fit_set_with_data(&sample.files, &options, bar)?;
+    // Only the plots draw the fitted data.
+    let prepared = if args.no_plots { Vec::new() } else { prepared };
     let mut notes = Vec::new();
-    let lines = write_fit_folder(update.path(), &sample.out, &mut result, args, &mut notes)?;
+    let lines = write_fit_folder(
+        update.path(),
+        &sample.out,
+        &mut result,
+        &prepared,
+        args,
+        &mut notes,
+    )?;
+    drop(prepared);
     update.commit()?;
     for warning in &result.warnings {
         say!("brtf: warning: {}: {warning}", sample.name);

@@ -79,14 +79,18 @@ pub fn run(args: FitArgs) -> Result<()> {
         if let Some(side) = side {
             bar.0.set_message(format!("{side} side "));
         }
-        let mut result = pool.install(|| brtf_fit::fit_set(&args.files, &options, &bar))?;
+        let brtf_fit::FittedSet {
+            mut result,
+            prepared,
+        } = pool.install(|| brtf_fit::fit_set_with_data(&args.files, &options, &bar))?;
         let (folder, shown) = match side {
             Some(side) if nested => (update.path().join(side.name()), out.join(side.name())),
             _ => (update.path().to_path_buf(), out.clone()),
         };
         std::fs::create_dir_all(&folder)
             .with_context(|| format!("creating {}", folder.display()))?;
-        let lines = write_fit_folder(&folder, &shown, &mut result, &args, &mut notes)?;
+        let lines = write_fit_folder(&folder, &shown, &mut result, &prepared, &args, &mut notes)?;
+        drop(prepared);
         printed += &format!("{}{lines}", brtf_fit::summary(&result, &shown));
         results.push(result);
     }
@@ -110,11 +114,13 @@ pub fn run(args: FitArgs) -> Result<()> {
 }
 
 /// Writes one fit's folder (`fit.json`, `params.csv`, exports, plots) into
-/// `stage`, shown to the user as `shown`; returns the lines to print.
+/// `stage`, shown to the user as `shown`; returns the lines to print. The
+/// plots draw the fitted data `prepared` (see [`brtf_fit::FittedSet`]).
 fn write_fit_folder(
     stage: &Path,
     shown: &Path,
     result: &mut brtf_fit::FitResult,
+    prepared: &[brtf_fit::PreparedMeasurement],
     args: &FitArgs,
     notes: &mut Vec<String>,
 ) -> Result<String> {
@@ -136,7 +142,7 @@ fn write_fit_folder(
     if !args.no_plots {
         let mut plot_options = brtf_plot::PlotOptions::default();
         plot_options.search_dirs.push(shown.to_path_buf());
-        let written = brtf_plot::write_plots(stage, result, &plot_options)
+        let written = brtf_plot::write_plots_with_data(stage, result, prepared, &plot_options)
             .with_context(|| format!("plotting into {}", shown.display()))?;
         outputs.extend(describe_outputs(stage, &written.files, Producer::Plot)?);
         lines += &format!(
@@ -199,9 +205,10 @@ fn default_name(files: &[PathBuf], klems: bool) -> Result<String> {
                 .header
                 .name
         } else {
-            brtf_gonio::read_path(file)
-                .with_context(|| format!("cannot read {}", file.display()))?
-                .sample_name
+            // The header alone: the fit reads and checks the whole file.
+            let bytes =
+                std::fs::read(file).with_context(|| format!("cannot read {}", file.display()))?;
+            brtf_gonio::read_sample_name(&bytes, file)
         };
         sample_names.push(name);
     }

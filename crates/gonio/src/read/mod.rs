@@ -75,6 +75,33 @@ pub fn read_bytes_as(
     }
 }
 
+/// The [`Measurement::sample_name`] that [`read_bytes`] would give, read
+/// from the header alone (what a command that only names a sample needs):
+/// a Mountain file's last `#sample_name` before its first data row; `None`
+/// for the other formats, which carry no sample name. The data rows are
+/// not read, so a file that [`read_bytes`] refuses may still get a name.
+pub fn read_sample_name(bytes: &[u8], name: impl AsRef<Path>) -> Option<String> {
+    if detect_format(bytes, name.as_ref()) != SourceFormat::Mountain {
+        return None;
+    }
+    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    // The header ends with the LF-ended piece that holds the first data
+    // row (a line that is neither blank nor a `#` comment); a lone-CR
+    // file is one piece, read whole.
+    let mut end = 0;
+    for piece in bytes.split_inclusive(|&b| b == b'\n') {
+        end += piece.len();
+        let data_row = piece
+            .split(|&b| b == b'\r' || b == b'\n')
+            .map(<[u8]>::trim_ascii)
+            .any(|line| !line.is_empty() && !line.starts_with(b"#"));
+        if data_row {
+            break;
+        }
+    }
+    mountain::header_sample_name(&text::decode(&bytes[..end]))
+}
+
 /// Guesses the format: a `.mpc` extension; else the header (a `#format:`
 /// or `#intheta` line means Mountain, which `.mpc` files never have; a
 /// `#using beam file`, `#incident angle …` or `#theta phi beam-ref …` line
@@ -497,6 +524,48 @@ fn same_incidence(a: (f64, f64), b: (f64, f64)) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_header_alone_gives_the_readers_sample_name() {
+        let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data");
+        let files = [
+            data.join("rgl-epfl-pgII-raw/golden_paper.txt"),
+            data.join("rgl-epfl-pgII-raw/layer_020_030.txt"),
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/pab-aluA-st1:+30+0.mpc"),
+        ];
+        for path in files {
+            let bytes = std::fs::read(&path).unwrap();
+            let whole = read_bytes(&bytes, &path).unwrap().sample_name;
+            assert_eq!(read_sample_name(&bytes, &path), whole, "{}", path.display());
+        }
+        let head = "#intheta 30\n#inphi 0\n#format: theta phi BSDF\n";
+        let rows = "10 0 0.5\n20 0 0.25\n";
+        let variants: Vec<Vec<u8>> = vec![
+            format!("#sample_name \"a\"\n{head}\n#sample_name: \"b c\"\n{rows}").into_bytes(),
+            format!("\u{feff}{head}#Sample_Name\tplain\r\n{rows}").into_bytes(),
+            format!("{head}#sample_name x\r\r{rows}")
+                .replace('\n', "\r")
+                .into_bytes(),
+            format!("{head}{rows}").into_bytes(),
+            [
+                head.as_bytes(),
+                b"#sample_name \"Fl\xe4che\"\n",
+                rows.as_bytes(),
+            ]
+            .concat(),
+        ];
+        let expected = [Some("b c"), Some("plain"), Some("x"), None, Some("Fläche")];
+        for (bytes, expected) in variants.iter().zip(expected) {
+            let whole = read_bytes(bytes, "x.txt").unwrap().sample_name;
+            assert_eq!(whole.as_deref(), expected);
+            assert_eq!(read_sample_name(bytes, "x.txt"), whole);
+        }
+        // A header line after the data is the reader's error; the header
+        // ends at the first row.
+        let late = format!("{head}{rows}#sample_name late\n");
+        assert!(read_bytes(late.as_bytes(), "x.txt").is_err());
+        assert_eq!(read_sample_name(late.as_bytes(), "x.txt"), None);
+    }
 
     #[test]
     fn file_name_incidence() {

@@ -83,6 +83,26 @@ pub(crate) fn unquote(text: &str) -> &str {
         .unwrap_or(text)
 }
 
+/// The last `#sample_name` of the header of `text` (the lines before the
+/// first data row), as [`parse`] reads it.
+pub(crate) fn header_sample_name(text: &str) -> Option<String> {
+    let mut sample_name = None;
+    for (_, line) in Lines::new(text) {
+        if line.trim_ascii().is_empty() {
+            continue;
+        }
+        if !line.trim_ascii_start().starts_with('#') {
+            break;
+        }
+        if let Some((key, rest)) = split_key(line)
+            && key == "sample_name"
+        {
+            sample_name = Some(unquote(rest).to_owned());
+        }
+    }
+    sample_name
+}
+
 pub(crate) fn parse(text: &str, name: &Path) -> Result<Measurement, ReadError> {
     let mut header: Vec<String> = Vec::new();
     let mut theta_in: Option<HeaderAngle> = None;
