@@ -2,54 +2,53 @@
 //! pairs, computed once per fit instead of on every pass.
 //!
 //! A Klems incidence averages the model over ~50 000 pairs, and LM needs
-//! ~80 passes: recomputing each pair's half vector and cosines on every
-//! pass was half the work. [`brtf_model::Geometry`] holds exactly the part
+//! ~70 passes: recomputing each pair's half vector and cosines on every
+//! pass was wasted work. [`brtf_model::Geometry`] holds exactly the part
 //! of `f(l, v)` that does not depend on the material's arguments, so it is
 //! valid for every parameter set the fit tries (same type, orientation and
-//! options).
+//! options). Stored as a structure of arrays, the sums over a sample's
+//! pairs run through brtf-model's vectorised kernel.
 
 use crate::data::PatchPairs;
-use brtf_model::{Bsdf, Geometry};
+use brtf_model::{Bsdf, GeometryBatch};
+use std::ops::Range;
 
 /// Every pair's geometry, sample by sample (the offsets of the
 /// [`PatchPairs`] it was made from).
 #[derive(Debug, Clone, Default)]
 pub(crate) struct PairGeometry {
-    /// Sample i's pairs are `geometry[offsets[i]..offsets[i + 1]]`.
+    /// Sample i's pairs are `offsets[i]..offsets[i + 1]` of `geometry`.
     offsets: Vec<usize>,
-    geometry: Vec<Geometry>,
+    pub geometry: GeometryBatch,
 }
 
 impl PairGeometry {
     /// The geometry of every pair of `pairs` under `bsdf`'s type,
     /// orientation and options (its arguments do not matter).
     pub(crate) fn new(pairs: &PatchPairs, bsdf: &Bsdf) -> PairGeometry {
-        let geometry = pairs
-            .lights
-            .iter()
-            .zip(&pairs.views)
-            .map(|(&l, &v)| bsdf.geometry(l, v))
-            .collect();
+        let mut geometry = GeometryBatch::with_capacity(pairs.lights.len());
+        bsdf.geometry_batch(&pairs.lights, &pairs.views, &mut geometry);
         PairGeometry {
             offsets: pairs.offsets.clone(),
             geometry,
         }
     }
 
-    /// Sample `i`'s pairs.
+    /// Sample `i`'s pairs in [`PairGeometry::geometry`].
     #[inline]
-    pub(crate) fn of(&self, i: usize) -> &[Geometry] {
-        &self.geometry[self.offsets[i]..self.offsets[i + 1]]
+    pub(crate) fn range(&self, i: usize) -> Range<usize> {
+        self.offsets[i]..self.offsets[i + 1]
     }
 
     /// The geometry of the samples `indices`, in that order.
     pub(crate) fn select(&self, indices: impl IntoIterator<Item = usize>) -> PairGeometry {
         let mut out = PairGeometry {
             offsets: vec![0],
-            geometry: Vec::new(),
+            geometry: GeometryBatch::new(),
         };
         for i in indices {
-            out.geometry.extend_from_slice(self.of(i));
+            out.geometry
+                .extend(self.range(i).map(|k| self.geometry.get(k)));
             out.offsets.push(out.geometry.len());
         }
         out

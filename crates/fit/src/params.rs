@@ -134,9 +134,19 @@ impl ParamMap {
             let p = s.lo + u.exp();
             return (p, u.exp());
         }
-        let sig = logistic(u);
+        // Past ±SATURATED the parameter sits at its bound (to 1e-7 of its
+        // range) and stops moving: without this, LM would crawl towards
+        // the bound for dozens of passes, since each step gains only a
+        // constant in u while the column shrinks like e^-|u|.
+        let saturated = u.abs() > SATURATED;
+        let sig = logistic(u.clamp(-SATURATED, SATURATED));
         let p = s.lo + (s.hi - s.lo) * sig;
-        (p, (s.hi - s.lo) * sig * (1.0 - sig))
+        let dp_du = if saturated {
+            0.0
+        } else {
+            (s.hi - s.lo) * sig * (1.0 - sig)
+        };
+        (p, dp_du)
     }
 
     /// Unconstrained value for physical `p` (clamped just inside the bounds).
@@ -173,6 +183,10 @@ impl ParamMap {
         !(1e-4..=1.0 - 1e-4).contains(&t)
     }
 }
+
+/// |u| beyond which a bounded parameter is at its bound: logistic(−16) ≈
+/// 1.1e-7 of the range.
+const SATURATED: f64 = 20.0;
 
 fn logistic(u: f64) -> f64 {
     if u >= 0.0 {

@@ -5,7 +5,7 @@
 use crate::data::{FitSample, PatchPairs};
 use crate::pair_geometry::PairGeometry;
 use crate::params::{ParamMap, Target};
-use brtf_model::{Bsdf, EvalOptions, Geometry, Gradient, Material};
+use brtf_model::{Bsdf, EvalOptions, Gradient, Material};
 use glam::DVec3;
 use levenberg_marquardt::LeastSquaresProblem;
 use nalgebra::{DMatrix, DVector, Dyn, Owned};
@@ -352,7 +352,7 @@ impl Kernel<'_> {
         for i in start..end {
             let s = &block.samples[i];
             let f = match (&block.pair_geometry, &block.pairs) {
-                (Some(geometry), _) => self.average(geometry.of(i)),
+                (Some(geometry), _) => self.average(geometry, i),
                 (None, Some(pairs)) => pairs.average(&self.bsdf, i),
                 (None, None) => self.bsdf.eval(block.light, s.view),
             };
@@ -385,9 +385,7 @@ impl Kernel<'_> {
         for i in start..end {
             let s = &block.samples[i];
             let f = match (&block.pair_geometry, &block.pairs) {
-                (Some(geometry), _) => {
-                    self.geometry_average_with_gradient(geometry.of(i), &mut grad)
-                }
+                (Some(geometry), _) => self.geometry_average_with_gradient(geometry, i, &mut grad),
                 (None, Some(pairs)) => self.average_with_gradient(pairs, i, &mut grad),
                 (None, None) => self.value_with_gradient(block.light, s.view, &mut grad),
             };
@@ -472,46 +470,39 @@ impl Kernel<'_> {
         sum.map(|s| s * inverse)
     }
 
-    /// [`Kernel::average_with_gradient`] on pairs whose geometry was
-    /// computed beforehand.
-    fn geometry_average_with_gradient(&self, pairs: &[Geometry], grad: &mut Gradient) -> [f64; 3] {
-        let mut sum = [0.0; 3];
-        let mut sum_grad = Gradient::default();
-        for g in pairs {
-            let f = if self.channels == 1 {
-                self.bsdf.eval_geometry_channels_with_gradient::<1>(g, grad)
-            } else {
-                self.bsdf.eval_geometry_with_gradient(g, grad)
-            };
-            for c in 0..3 {
-                sum[c] += f[c];
-            }
-            for (total, d) in sum_grad.d.iter_mut().zip(&grad.d) {
-                for c in 0..3 {
-                    total[c] += d[c];
-                }
-            }
-        }
-        let inverse = 1.0 / pairs.len().max(1) as f64;
-        for (out, total) in grad.d.iter_mut().zip(&sum_grad.d) {
-            for c in 0..3 {
-                out[c] = total[c] * inverse;
+    /// [`Kernel::average_with_gradient`] on sample `i`'s pairs, whose
+    /// geometry was computed beforehand (vectorised over the pairs).
+    fn geometry_average_with_gradient(
+        &self,
+        pairs: &PairGeometry,
+        i: usize,
+        grad: &mut Gradient,
+    ) -> [f64; 3] {
+        let range = pairs.range(i);
+        let inverse = 1.0 / range.len().max(1) as f64;
+        let sum = if self.channels == 1 {
+            self.bsdf
+                .sum_geometry_with_gradient::<1>(&pairs.geometry, range, grad)
+        } else {
+            self.bsdf
+                .sum_geometry_with_gradient::<3>(&pairs.geometry, range, grad)
+        };
+        for d in grad.d.iter_mut() {
+            for c in d.iter_mut() {
+                *c *= inverse;
             }
         }
         sum.map(|s| s * inverse)
     }
 
-    /// The BSDF averaged over pairs whose geometry was computed beforehand.
-    fn average(&self, pairs: &[Geometry]) -> [f64; 3] {
-        let mut sum = [0.0; 3];
-        for g in pairs {
-            let f = self.bsdf.eval_geometry(g);
-            for c in 0..3 {
-                sum[c] += f[c];
-            }
-        }
-        let inverse = 1.0 / pairs.len().max(1) as f64;
-        sum.map(|s| s * inverse)
+    /// The BSDF averaged over sample `i`'s pairs, whose geometry was
+    /// computed beforehand.
+    fn average(&self, pairs: &PairGeometry, i: usize) -> [f64; 3] {
+        let range = pairs.range(i);
+        let inverse = 1.0 / range.len().max(1) as f64;
+        self.bsdf
+            .sum_geometry::<3>(&pairs.geometry, range)
+            .map(|s| s * inverse)
     }
 
     /// The residual for BSDF value `f`, measured `y` and factor `k`, dr/dm,
