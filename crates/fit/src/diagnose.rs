@@ -21,6 +21,7 @@ use crate::report::FitReport;
 use brtf_gonio::Hemisphere;
 use brtf_model::{Bsdf, Material};
 use glam::DVec3;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// Energy ratio (data ÷ model) outside [1/(1+t), 1+t] warns.
@@ -109,15 +110,33 @@ pub(crate) fn measured_integrals(
     bsdf: &Bsdf,
     scale: f64,
 ) -> Measured {
+    measured_sums(prepared, &fitted_model(prepared, bsdf), scale)
+}
+
+/// The model's value (in luminance) at every fitted sample of `prepared`,
+/// in the order of [`PreparedMeasurement::fitted`]. Evaluated in parallel;
+/// the sums over them stay in sample order.
+fn fitted_model(prepared: &PreparedMeasurement, bsdf: &Bsdf) -> Vec<f64> {
+    let channels = prepared.channels();
+    let indices: Vec<usize> = prepared.fitted().map(|(i, _)| i).collect();
+    indices
+        .par_iter()
+        .with_min_len(4096)
+        .map(|&i| luminance(prepared.model_value(bsdf, i), channels))
+        .collect()
+}
+
+/// [`measured_integrals`] with the model's values `model` from
+/// [`fitted_model`].
+fn measured_sums(prepared: &PreparedMeasurement, model: &[f64], scale: f64) -> Measured {
     let channels = prepared.channels();
     let mut sums = [[0.0; 2]; 2];
     let mut seen = [false; 2];
-    for (i, s) in prepared.fitted() {
+    for ((_, s), &f) in prepared.fitted().zip(model) {
         let weight = s.solid_angle_sr.unwrap_or(0.0) * s.abs_cos_theta();
         let side = usize::from(s.hemisphere() == Hemisphere::Back);
-        let f = prepared.model_value(bsdf, i);
         sums[side][0] += weight * luminance(s.values, channels);
-        sums[side][1] += weight * scale * luminance(f, channels);
+        sums[side][1] += weight * scale * f;
         seen[side] = true;
     }
     let pick = |side: usize| seen[side].then_some((sums[side][0], sums[side][1]));
@@ -147,7 +166,8 @@ pub(crate) fn diagnose(
     let bsdf = Bsdf::new(&material, &config.options);
     let scale = report.scale;
     let (rho_model, tau_model) = model_albedo(prepared, &bsdf);
-    let measured = measured_integrals(prepared, &bsdf, scale);
+    let model = fitted_model(prepared, &bsdf);
+    let measured = measured_sums(prepared, &model, scale);
     // Data's reflectance: measured part ÷ scale, plus the model's rest.
     let complete = |part: Option<(f64, f64)>, model_total: f64| {
         part.map(|(data, model)| model_total + (data - model) / scale)
@@ -157,7 +177,7 @@ pub(crate) fn diagnose(
         rho_model,
         tau_data: complete(measured.back, tau_model),
         tau_model,
-        peak_offset_deg: peak_offset(prepared, &bsdf),
+        peak_offset_deg: peak_offset(prepared, &model),
         residual_check: None,
     })
 }
@@ -165,16 +185,14 @@ pub(crate) fn diagnose(
 /// Angle between the centroids of the brightest data and model samples,
 /// over the fitted directions of the hemisphere that holds the brightest
 /// data sample. `None` when the data have no distinct peak (their
-/// brightest samples are less than twice their median).
-fn peak_offset(prepared: &PreparedMeasurement, bsdf: &Bsdf) -> Option<f64> {
+/// brightest samples are less than twice their median). `model` holds the
+/// model's values at the fitted samples ([`fitted_model`]).
+fn peak_offset(prepared: &PreparedMeasurement, model: &[f64]) -> Option<f64> {
     let channels = prepared.channels();
     let samples: Vec<(DVec3, f64, f64)> = prepared
         .fitted()
-        .map(|(i, s)| {
-            let v = s.direction();
-            let y = luminance(s.values, channels);
-            (v, y, luminance(prepared.model_value(bsdf, i), channels))
-        })
+        .zip(model)
+        .map(|((_, s), &f)| (s.direction(), luminance(s.values, channels), f))
         .filter(|(_, y, _)| y.is_finite())
         .collect();
     if samples.len() < 10 {
@@ -182,20 +200,14 @@ fn peak_offset(prepared: &PreparedMeasurement, bsdf: &Bsdf) -> Option<f64> {
     }
     let count = ((samples.len() as f64 * PEAK_FRACTION).ceil() as usize).clamp(3, samples.len());
     let centroid = |value: &dyn Fn(&(DVec3, f64, f64)) -> f64| -> (DVec3, f64) {
-        let mut order: Vec<usize> = (0..samples.len()).collect();
-        order.sort_by(|&a, &b| value(&samples[b]).total_cmp(&value(&samples[a])));
-        let top = &order[..count];
-        let sum: DVec3 = top
-            .iter()
-            .map(|&i| samples[i].0 * value(&samples[i]).max(0.0))
-            .sum();
-        let mut all: Vec<f64> = samples.iter().map(value).collect();
+        let values: Vec<f64> = samples.iter().map(value).collect();
+        let top = brightest(&values, count);
+        let sum: DVec3 = top.iter().map(|&i| samples[i].0 * values[i].max(0.0)).sum();
+        let brightest = values[top[0]];
+        let mut all = values;
         let mid = all.len() / 2;
         let median = *all.select_nth_unstable_by(mid, f64::total_cmp).1;
-        (
-            sum.normalize_or_zero(),
-            value(&samples[top[0]]) / median.max(1e-300),
-        )
+        (sum.normalize_or_zero(), brightest / median.max(1e-300))
     };
     let (data_peak, contrast) = centroid(&|s| s.1);
     let (model_peak, _) = centroid(&|s| s.2);
@@ -209,6 +221,18 @@ fn peak_offset(prepared: &PreparedMeasurement, bsdf: &Bsdf) -> Option<f64> {
             .acos()
             .to_degrees(),
     )
+}
+
+/// The indices of the `count` largest `values`, largest first and in index
+/// order among equals: the head of a stable sort by decreasing value,
+/// found by a selection and a sort of the head alone. `count` ≥ 1.
+fn brightest(values: &[f64], count: usize) -> Vec<usize> {
+    let brighter = |a: &usize, b: &usize| values[*b].total_cmp(&values[*a]).then(a.cmp(b));
+    let mut order: Vec<usize> = (0..values.len()).collect();
+    order.select_nth_unstable_by(count - 1, brighter);
+    order.truncate(count);
+    order.sort_unstable_by(brighter);
+    order
 }
 
 /// The residual kind of the second fit: log for absolute residuals,
@@ -270,4 +294,30 @@ pub(crate) fn warnings(a: &Adequacy) -> Vec<crate::FitWarning> {
         });
     }
     warnings
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_brightest_are_the_head_of_a_stable_sort() {
+        // Many ties, negative values and both zeros, in a scrambled order.
+        let values: Vec<f64> = (0..5000u64)
+            .map(|i| {
+                let h = i.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 40;
+                match h % 7 {
+                    0 => 0.0,
+                    1 => -0.0,
+                    2 => -((h % 13) as f64),
+                    _ => (h % 97) as f64 * 0.25,
+                }
+            })
+            .collect();
+        let mut stable: Vec<usize> = (0..values.len()).collect();
+        stable.sort_by(|&a, &b| values[b].total_cmp(&values[a]));
+        for count in [1, 3, 10, 11, 250, 4999, 5000] {
+            assert_eq!(brightest(&values, count), stable[..count], "count {count}");
+        }
+    }
 }

@@ -165,12 +165,18 @@ pub fn fit_set_with_data(
     let other_early = options.adequacy && options.known_reflectance.is_none();
     let steps = fit_all_steps(inputs.len()) + if other_early { inputs.len() } else { 0 };
     progress.begin(steps as u64);
+    // The energy and peak diagnostics follow the main fits there, while
+    // the second fits may still run.
     let (main, early) = rayon::join(
-        || fit_all(&inputs, &config, progress),
+        || {
+            let (reports, global) = fit_all(&inputs, &config, progress)?;
+            let adequacy = other_early.then(|| diagnose_all(&inputs, &reports, &config));
+            Ok::<_, FitSetError>((reports, global, adequacy))
+        },
         || other_early.then(|| other_fits(&inputs, &config, progress)),
     );
     progress.end();
-    let (mut reports, mut global) = main?;
+    let (mut reports, mut global, early_adequacy) = main?;
 
     // A known reflectance turns a free-scale fit absolute: the data's own
     // ρ_dh at that incidence (measured directions from the data, the rest
@@ -220,7 +226,8 @@ pub fn fit_set_with_data(
                 others
             }
         };
-        assess(&inputs, &mut reports, &config, others);
+        let adequacy = early_adequacy.unwrap_or_else(|| diagnose_all(&inputs, &reports, &config));
+        assess(&mut reports, &config, adequacy, others);
     }
 
     // Klems incidences come in θ rings of azimuth patches: the table
@@ -398,18 +405,33 @@ fn other_fits(
         .collect()
 }
 
-/// The adequacy diagnostics of every incidence, with the fits made with
-/// the other residual kind (`others`, from [`other_fits`] on the same
-/// data), and their warnings.
-fn assess(
+/// The energy and peak diagnostics of every incidence's fit (see
+/// [`diagnose::diagnose`]), in parallel.
+fn diagnose_all(
     inputs: &[Input],
+    reports: &[FitReport],
+    config: &FitConfig,
+) -> Vec<Option<diagnose::Adequacy>> {
+    inputs
+        .par_iter()
+        .zip(reports)
+        .map(|(input, report)| diagnose::diagnose(&input.prepared, report, config))
+        .collect()
+}
+
+/// Completes the adequacy diagnostics of every incidence (`adequacy`,
+/// from [`diagnose_all`]) with the fits made with the other residual kind
+/// (`others`, from [`other_fits`] on the same data), and adds their
+/// warnings.
+fn assess(
     reports: &mut [FitReport],
     config: &FitConfig,
+    adequacy: Vec<Option<diagnose::Adequacy>>,
     others: Vec<Option<FitReport>>,
 ) {
     let other = diagnose::other_residual(config.residual);
-    for ((input, report), other_fit) in inputs.iter().zip(reports.iter_mut()).zip(others) {
-        let Some(mut adequacy) = diagnose::diagnose(&input.prepared, report, config) else {
+    for ((report, adequacy), other_fit) in reports.iter_mut().zip(adequacy).zip(others) {
+        let Some(mut adequacy) = adequacy else {
             continue;
         };
         adequacy.residual_check = other_fit.and_then(|o| diagnose::compare(report, &o, other));
