@@ -5,7 +5,7 @@
 use crate::data::{FitSample, PatchPairs};
 use crate::pair_geometry::PairGeometry;
 use crate::params::{ParamMap, Target};
-use brtf_model::{Bsdf, EvalOptions, Gradient, Material};
+use brtf_model::{Bsdf, EvalOptions, GeometryBatch, Gradient, Material};
 use glam::DVec3;
 use levenberg_marquardt::LeastSquaresProblem;
 use nalgebra::{DMatrix, DVector, Dyn, Owned};
@@ -13,6 +13,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::borrow::Cow;
 use std::cell::{Cell, RefCell};
+use std::ops::Range;
 
 /// How a model value m is compared with a measured value y.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
@@ -349,12 +350,13 @@ impl Kernel<'_> {
         let channels = self.channels;
         let mut data = Vec::with_capacity((end - start) * channels);
         let mut sum_rel = 0.0;
+        let mut scratch = GeometryBatch::new();
         for i in start..end {
             let s = &block.samples[i];
-            let f = match (&block.pair_geometry, &block.pairs) {
-                (Some(geometry), _) => self.average(geometry, i),
-                (None, Some(pairs)) => pairs.average(&self.bsdf, i),
-                (None, None) => self.bsdf.eval(block.light, s.view),
+            let f = if block.pairs.is_some() {
+                self.average(block, i, &mut scratch)
+            } else {
+                self.bsdf.eval(block.light, s.view)
             };
             for ch in 0..channels {
                 let row = i * channels + ch;
@@ -382,12 +384,13 @@ impl Kernel<'_> {
         let mut x = [0.0; W];
         let mut grad = Gradient::default();
         let mut sum_rel = 0.0;
+        let mut scratch = GeometryBatch::new();
         for i in start..end {
             let s = &block.samples[i];
-            let f = match (&block.pair_geometry, &block.pairs) {
-                (Some(geometry), _) => self.geometry_average_with_gradient(geometry, i, &mut grad),
-                (None, Some(pairs)) => self.average_with_gradient(pairs, i, &mut grad),
-                (None, None) => self.value_with_gradient(block.light, s.view, &mut grad),
+            let f = if block.pairs.is_some() {
+                self.average_with_gradient(block, i, &mut grad, &mut scratch)
+            } else {
+                self.value_with_gradient(block.light, s.view, &mut grad)
             };
             for ch in 0..channels {
                 let row = i * channels + ch;
@@ -444,48 +447,25 @@ impl Kernel<'_> {
         }
     }
 
-    /// The BSDF and its gradient averaged over sample `i`'s pairs: the
-    /// patch average is linear, so its gradient is the average gradient.
-    fn average_with_gradient(&self, pairs: &PatchPairs, i: usize, grad: &mut Gradient) -> [f64; 3] {
-        let (lights, views) = pairs.of(i);
-        let mut sum = [0.0; 3];
-        let mut sum_grad = Gradient::default();
-        for (&light, &view) in lights.iter().zip(views) {
-            let f = self.value_with_gradient(light, view, grad);
-            for c in 0..3 {
-                sum[c] += f[c];
-            }
-            for (total, d) in sum_grad.d.iter_mut().zip(&grad.d) {
-                for c in 0..3 {
-                    total[c] += d[c];
-                }
-            }
-        }
-        let inverse = 1.0 / lights.len().max(1) as f64;
-        for (out, total) in grad.d.iter_mut().zip(&sum_grad.d) {
-            for c in 0..3 {
-                out[c] = total[c] * inverse;
-            }
-        }
-        sum.map(|s| s * inverse)
-    }
-
-    /// [`Kernel::average_with_gradient`] on sample `i`'s pairs, whose
-    /// geometry was computed beforehand (vectorised over the pairs).
-    fn geometry_average_with_gradient(
+    /// The BSDF and its gradient averaged over sample `i`'s pairs (the
+    /// patch average is linear, so its gradient is the average gradient):
+    /// from the pairs' cached geometry, or else from the pairs, through
+    /// `scratch`. Either way the sums run in brtf-model's vectorised kernel.
+    fn average_with_gradient(
         &self,
-        pairs: &PairGeometry,
+        block: &Block<'_>,
         i: usize,
         grad: &mut Gradient,
+        scratch: &mut GeometryBatch,
     ) -> [f64; 3] {
-        let range = pairs.range(i);
+        let (geometry, range) = self.pair_geometry(block, i, scratch);
         let inverse = 1.0 / range.len().max(1) as f64;
         let sum = if self.channels == 1 {
             self.bsdf
-                .sum_geometry_with_gradient::<1>(&pairs.geometry, range, grad)
+                .sum_geometry_with_gradient::<1>(geometry, range, grad)
         } else {
             self.bsdf
-                .sum_geometry_with_gradient::<3>(&pairs.geometry, range, grad)
+                .sum_geometry_with_gradient::<3>(geometry, range, grad)
         };
         for d in grad.d.iter_mut() {
             for c in d.iter_mut() {
@@ -495,14 +475,34 @@ impl Kernel<'_> {
         sum.map(|s| s * inverse)
     }
 
-    /// The BSDF averaged over sample `i`'s pairs, whose geometry was
-    /// computed beforehand.
-    fn average(&self, pairs: &PairGeometry, i: usize) -> [f64; 3] {
-        let range = pairs.range(i);
+    /// The BSDF averaged over sample `i`'s pairs; see
+    /// [`Kernel::average_with_gradient`].
+    fn average(&self, block: &Block<'_>, i: usize, scratch: &mut GeometryBatch) -> [f64; 3] {
+        let (geometry, range) = self.pair_geometry(block, i, scratch);
         let inverse = 1.0 / range.len().max(1) as f64;
         self.bsdf
-            .sum_geometry::<3>(&pairs.geometry, range)
+            .sum_geometry::<3>(geometry, range)
             .map(|s| s * inverse)
+    }
+
+    /// The geometry of sample `i`'s pairs: cached, or computed into
+    /// `scratch`.
+    fn pair_geometry<'s>(
+        &self,
+        block: &'s Block<'_>,
+        i: usize,
+        scratch: &'s mut GeometryBatch,
+    ) -> (&'s GeometryBatch, Range<usize>) {
+        match (&block.pair_geometry, &block.pairs) {
+            (Some(cached), _) => (&cached.geometry, cached.range(i)),
+            (None, Some(pairs)) => {
+                let (lights, views) = pairs.of(i);
+                scratch.clear();
+                self.bsdf.geometry_batch(lights, views, scratch);
+                (&*scratch, 0..lights.len())
+            }
+            (None, None) => unreachable!("patch-averaged blocks have pairs"),
+        }
     }
 
     /// The residual for BSDF value `f`, measured `y` and factor `k`, dr/dm,
