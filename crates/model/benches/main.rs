@@ -2,7 +2,8 @@
 //! cost, and ρ_dh time per incidence. Seeded inputs, one bench binary.
 
 use brtf_model::{
-    Bsdf, Directions, EvalOptions, Gradient, Material, MaterialKind, RgbBatch, albedo, direction,
+    Bsdf, Directions, EvalOptions, Geometry, GeometryBatch, Gradient, Material, MaterialKind,
+    RgbBatch, albedo, direction,
 };
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::DVec3;
@@ -104,6 +105,98 @@ fn bench_eval_batch(c: &mut Criterion) {
     group.finish();
 }
 
+/// Pairs in a Klems-like incidence.
+const PATCH_PAIRS: usize = 100_000;
+
+/// A Klems incidence's (light, view) pairs: lights spread over a patch
+/// around θ = 30°, a sixth of the views within 5° of the mirror direction,
+/// a sixth within 5° of straight through, the rest spread over both
+/// hemispheres.
+fn klems_pairs() -> (Vec<DVec3>, Vec<DVec3>) {
+    let mut state = 0x5851_F42D_4C95_7F2Du64;
+    let mut uniform = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    (0..PATCH_PAIRS)
+        .map(|i| {
+            let (ti, pi) = (25.0 + 10.0 * uniform(), 10.0 * uniform());
+            let (dt, dp) = (10.0 * (uniform() - 0.5), 10.0 * (uniform() - 0.5));
+            let v = match i % 6 {
+                0 => direction(ti + dt, pi + 180.0 + dp),
+                1 => direction(180.0 - ti + dt, pi + 180.0 + dp),
+                2 | 3 => direction(90.0 * uniform(), 360.0 * uniform()),
+                _ => direction(90.0 + 90.0 * uniform(), 360.0 * uniform()),
+            };
+            (direction(ti, pi), v)
+        })
+        .unzip()
+}
+
+/// What a fit to patch averages does on every iteration: the sums of `f`
+/// and its gradient over runs of `RUN` pairs, the geometry precomputed.
+/// `scalar`: `eval_geometry_channels_with_gradient` per pair; `batch`:
+/// `sum_geometry_with_gradient` per run. Rates are pairs per second.
+fn bench_patch_sum(c: &mut Criterion) {
+    const RUN: usize = 128;
+    let (lights, views) = klems_pairs();
+    let mut group = c.benchmark_group("patch_sum");
+    group.throughput(Throughput::Elements(PATCH_PAIRS as u64));
+    for kind in [
+        MaterialKind::Metal,
+        MaterialKind::Plastic,
+        MaterialKind::Trans,
+    ] {
+        let bsdf = Bsdf::new(&material(kind), &EvalOptions::default());
+        let geometry: Vec<Geometry> = lights
+            .iter()
+            .zip(&views)
+            .map(|(&l, &v)| bsdf.geometry(l, v))
+            .collect();
+        let mut batch = GeometryBatch::new();
+        bsdf.geometry_batch(&lights, &views, &mut batch);
+        let name = kind.name();
+        group.bench_function(format!("{name}/scalar"), |b| {
+            let (mut grad, mut grad_sum) = (Gradient::default(), Gradient::default());
+            b.iter(|| {
+                let mut total = 0.0;
+                for run in geometry.chunks(RUN) {
+                    let mut f_sum = 0.0;
+                    grad_sum.d = [[0.0; 3]; 8];
+                    for g in run {
+                        f_sum += black_box(&bsdf)
+                            .eval_geometry_channels_with_gradient::<1>(g, &mut grad)[0];
+                        for (s, d) in grad_sum.d.iter_mut().zip(&grad.d) {
+                            s[0] += d[0];
+                        }
+                    }
+                    total += f_sum + grad_sum.d[4][0];
+                }
+                total
+            })
+        });
+        group.bench_function(format!("{name}/batch"), |b| {
+            let mut grad_sum = Gradient::default();
+            b.iter(|| {
+                let mut total = 0.0;
+                for start in (0..PATCH_PAIRS).step_by(RUN) {
+                    let range = start..(start + RUN).min(PATCH_PAIRS);
+                    total += black_box(&bsdf).sum_geometry_with_gradient::<1>(
+                        &batch,
+                        range,
+                        &mut grad_sum,
+                    )[0];
+                    total += grad_sum.d[4][0];
+                }
+                total
+            })
+        });
+    }
+    group.finish();
+}
+
 fn bench_albedo(c: &mut Criterion) {
     let mut group = c.benchmark_group("albedo");
     for (kind, theta) in [
@@ -122,5 +215,11 @@ fn bench_albedo(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench_eval, bench_eval_batch, bench_albedo);
+criterion_group!(
+    benches,
+    bench_eval,
+    bench_eval_batch,
+    bench_patch_sum,
+    bench_albedo
+);
 criterion_main!(benches);
