@@ -15,15 +15,18 @@ use brtf_gonio::{Hemisphere, Measurement, compute_solid_angles};
 
 use crate::common::{golden, layer};
 
-/// Per-cell agreement demanded: rounding only. Both methods compute the
-/// Voronoi corners with the same formula, but from each triangle's vertices
-/// in whatever rotation its triangulation stores them; for near-flat
-/// triangles (the real scans' near-collinear paths) the corner is far away
-/// and its rounding is amplified, and a cell that has such a corner differs
-/// by up to about 2e-9 relative (worst seen: 1.1e-9 on golden_paper,
-/// 1.5e-9 on layer_020_030, 2.2e-9 on the synthetic sets, where the
-/// triangles around the worst cell were checked to be the same).
+/// Per-cell agreement demanded: rounding only, 5e-9 relative or 1e-16 sr
+/// absolute (one rounding of a coordinate of size 1). Both methods compute
+/// the Voronoi corners with the same formula, but from each triangle's
+/// vertices in whatever rotation its triangulation stores them; for
+/// near-flat triangles (near-collinear paths, tight clusters) the corner's
+/// rounding is amplified. Worst seen (24 November 2026): 1.1e-9 relative on
+/// golden_paper and 1.5e-9 on layer_020_030 (1.4e-17 and 2.8e-17 sr, one
+/// cell each above 1e-9; around the golden_paper one both triangulations
+/// have the same triangles), 2.1e-9 on the synthetic paths, and 6.5e-8
+/// relative but 6.9e-18 sr absolute on a 1e-10 sr cell of a tight cluster.
 const TOLERANCE: f64 = 5e-9;
+const ABSOLUTE_TOLERANCE_SR: f64 = 1e-16;
 
 /// A small deterministic generator (xorshift64*), uniform in [0, 1).
 struct Rng(u64);
@@ -57,7 +60,7 @@ fn compare(name: &str, points: &[[f64; 2]]) -> f64 {
     for (i, (f, r)) in fast.iter().zip(&reference).enumerate() {
         let difference = (f - r).abs() / r.abs().max(1e-300);
         assert!(
-            difference <= TOLERANCE,
+            difference <= TOLERANCE || (f - r).abs() <= ABSOLUTE_TOLERANCE_SR,
             "{name}: point {i} {:?}: cell {f} against the reference's {r} ({difference:e})",
             points[i]
         );
@@ -115,7 +118,10 @@ fn real_scans_give_the_reference_cells() {
             .collect();
         assert_eq!(front.len(), reference.len());
         for (w, r) in front.iter().zip(&reference) {
-            assert!((w - r).abs() <= TOLERANCE * r, "{name}: {w} against {r}");
+            assert!(
+                (w - r).abs() <= TOLERANCE * r || (w - r).abs() <= ABSOLUTE_TOLERANCE_SR,
+                "{name}: {w} against {r}"
+            );
         }
     }
 }

@@ -118,9 +118,12 @@ pub fn disk_voronoi_areas(points: &[[f64; 2]]) -> Vec<f64> {
         group_of[i as usize] = g as u32;
         group_size[g] += 1;
     }
-    let Some(tri) =
-        delaunay::triangulate_in_polygon(&vertices, GHOSTS, GHOSTS as u32..vertices.len() as u32)
-    else {
+    let insertion = delaunay::brio_order(group_size.len());
+    let Some(tri) = delaunay::triangulate_in_polygon(
+        &vertices,
+        GHOSTS,
+        insertion.into_iter().map(|k| k + GHOSTS as u32),
+    ) else {
         return reference_disk_voronoi_areas(points);
     };
     let Some(cell_areas) = cell_areas(&vertices, &tri) else {
