@@ -6,6 +6,7 @@
 
 use std::path::Path;
 
+use rayon::prelude::*;
 use roxmltree::{Document, Node};
 
 use super::{
@@ -125,8 +126,56 @@ impl<'a, 'input> Reader<'a, 'input> {
             .map(|node| self.angle_basis(node))
             .collect::<Result<Vec<_>, _>>()?;
 
+        // Check every block's structure first, in document order; then
+        // parse the matrices (most of the work) in parallel, and report
+        // the first error in document order, as a sequential read would.
         let mut basis: Option<KlemsBasis> = None;
-        let mut matrices: Vec<KlemsMatrix> = Vec::new();
+        let mut pending: Vec<PendingMatrix<'a, 'input>> = Vec::new();
+        let structure_error = self
+            .collect_blocks(layer, &defined, &mut basis, &mut pending)
+            .err();
+        let parsed: Vec<Result<ParsedMatrix, ReadError>> = pending
+            .par_iter()
+            .map(|p| self.matrix(p.data_node, &p.what, p.n, rows))
+            .collect();
+        let mut matrices: Vec<KlemsMatrix> = Vec::with_capacity(pending.len());
+        let mut lines = LineCounter::new(self.doc.input_text());
+        for (p, m) in pending.into_iter().zip(parsed) {
+            let m = m?;
+            matrices.push(KlemsMatrix {
+                band: p.band,
+                direction: p.direction,
+                n: m.n,
+                values: m.values,
+                clipped_negative: m.clipped,
+                line: lines.line_at(p.data_node.range().start),
+            });
+        }
+        if let Some(e) = structure_error {
+            return Err(e);
+        }
+        let Some(basis) = basis else {
+            return Err(self.error(layer, KlemsProblem::NoData));
+        };
+        Ok(KlemsBsdf {
+            source: self.name.display().to_string(),
+            header,
+            incident_data_structure: if rows { "Rows" } else { "Columns" }.into(),
+            basis,
+            matrices,
+        })
+    }
+
+    /// Checks every `WavelengthDataBlock` of `layer` in document order and
+    /// queues its `ScatteringData` for parsing; stops at the first fault,
+    /// keeping what was queued before it.
+    fn collect_blocks(
+        &self,
+        layer: Node<'a, 'input>,
+        defined: &[(String, Option<KlemsBasis>)],
+        basis: &mut Option<KlemsBasis>,
+        pending: &mut Vec<PendingMatrix<'a, 'input>>,
+    ) -> Result<(), ReadError> {
         for data in children(layer, "WavelengthData") {
             let band_node = self.required(data, "Wavelength")?;
             let band = KlemsBand::parse(band_node.text().unwrap_or(""));
@@ -142,8 +191,8 @@ impl<'a, 'input> Reader<'a, 'input> {
                 let what = format!("{band} {direction}");
                 let column_node = self.required(block, "ColumnAngleBasis")?;
                 let row_node = self.required(block, "RowAngleBasis")?;
-                let column = self.resolve_basis(column_node, &defined)?;
-                let row = self.resolve_basis(row_node, &defined)?;
+                let column = self.resolve_basis(column_node, defined)?;
+                let row = self.resolve_basis(row_node, defined)?;
                 if !column.same_geometry(&row) {
                     return Err(self.error(
                         row_node,
@@ -153,7 +202,7 @@ impl<'a, 'input> Reader<'a, 'input> {
                         },
                     ));
                 }
-                if let Some(first) = &basis
+                if let Some(first) = &*basis
                     && !first.same_geometry(&column)
                 {
                     return Err(self.error(
@@ -164,35 +213,25 @@ impl<'a, 'input> Reader<'a, 'input> {
                         },
                     ));
                 }
-                if matrices
+                if pending
                     .iter()
                     .any(|m| m.band == band && m.direction == direction)
                 {
                     return Err(self.error(direction_node, KlemsProblem::Duplicate(what)));
                 }
                 let data_node = self.required(block, "ScatteringData")?;
-                let matrix = self.matrix(data_node, &what, column.len(), rows)?;
+                let n = column.len();
                 basis.get_or_insert(column);
-                matrices.push(KlemsMatrix {
+                pending.push(PendingMatrix {
                     band: band.clone(),
                     direction,
-                    n: matrix.n,
-                    values: matrix.values,
-                    clipped_negative: matrix.clipped,
-                    line: self.line_of(data_node),
+                    what,
+                    n,
+                    data_node,
                 });
             }
         }
-        let Some(basis) = basis else {
-            return Err(self.error(layer, KlemsProblem::NoData));
-        };
-        Ok(KlemsBsdf {
-            source: self.name.display().to_string(),
-            header,
-            incident_data_structure: if rows { "Rows" } else { "Columns" }.into(),
-            basis,
-            matrices,
-        })
+        Ok(())
     }
 
     /// One `AngleBasis`: its name and, when it has blocks, its rings.
@@ -408,6 +447,47 @@ fn tokens(text: &str) -> impl Iterator<Item = &str> {
         }
         Some(&text[start..pos])
     })
+}
+
+/// A `ScatteringData` element whose block has been checked.
+struct PendingMatrix<'a, 'input> {
+    band: KlemsBand,
+    direction: KlemsDirection,
+    /// "band direction", for messages.
+    what: String,
+    n: usize,
+    data_node: Node<'a, 'input>,
+}
+
+/// Line numbers of increasing byte offsets in one pass over the text
+/// (roxmltree's `text_pos_at` scans from the start on every call).
+struct LineCounter<'t> {
+    text: &'t [u8],
+    offset: usize,
+    line: usize,
+}
+
+impl<'t> LineCounter<'t> {
+    fn new(text: &'t str) -> LineCounter<'t> {
+        LineCounter {
+            text: text.as_bytes(),
+            offset: 0,
+            line: 1,
+        }
+    }
+
+    /// The 1-based line of byte `offset` (offsets must not decrease).
+    fn line_at(&mut self, offset: usize) -> usize {
+        let offset = offset.min(self.text.len());
+        if offset >= self.offset {
+            self.line += self.text[self.offset..offset]
+                .iter()
+                .filter(|&&b| b == b'\n')
+                .count();
+            self.offset = offset;
+        }
+        self.line
+    }
 }
 
 struct ParsedMatrix {
