@@ -880,3 +880,74 @@ fn simd_terms<
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::direction;
+    use crate::kind::MaterialKind;
+    use crate::material::Material;
+    use crate::options::EvalOptions;
+    use pulp::WithSimd;
+
+    /// The kernel's sums on one SIMD level, for `bsdf` (rough trans,
+    /// Radiance variant) over `range`.
+    fn sums_on<S: pulp::Simd>(
+        simd: S,
+        bsdf: &Bsdf,
+        batch: &GeometryBatch,
+        range: Range<usize>,
+    ) -> [[f64; 3]; ROWS] {
+        let k = bsdf.sum_constants();
+        let op = SumOp::<true, 3, false, true, RADIANCE, false> {
+            k: &k,
+            g: batch.columns(range),
+        };
+        op.with_simd(simd)
+    }
+
+    /// Whatever level `pulp` picks (AVX-512, AVX2 or the scalar baseline),
+    /// one pair's terms are the same bits, and long sums agree to rounding.
+    #[test]
+    fn every_simd_level_gives_the_same_terms() {
+        let material = Material::new(
+            MaterialKind::Trans,
+            &[0.6, 0.7, 0.8, 0.04, 0.05, 0.6, 0.4],
+            None,
+        )
+        .unwrap();
+        let bsdf = Bsdf::new(&material, &EvalOptions::default());
+        let mut batch = GeometryBatch::new();
+        for i in 0..203 {
+            let l = direction(20.0 + 0.3 * i as f64, 10.0);
+            let v = direction((7.3 * i as f64) % 180.0, 190.0 + 0.5 * i as f64);
+            batch.push(bsdf.geometry(l, v));
+        }
+        let n = batch.len();
+        let scalar = pulp::Scalar::new();
+        let whole = sums_on(scalar, &bsdf, &batch, 0..n);
+        // Not vacuous: values, colour, specularity, roughness, trans and
+        // tspec derivatives are all non-zero.
+        for row in 0..6 {
+            assert!(whole[row].iter().all(|&x| x != 0.0), "row {row}: {whole:?}");
+        }
+        let check = |sums: &dyn Fn(Range<usize>) -> [[f64; 3]; ROWS]| {
+            for i in 0..n {
+                assert_eq!(sums(i..i + 1), sums_on(scalar, &bsdf, &batch, i..i + 1));
+            }
+            let (got, want) = (sums(0..n), sums_on(scalar, &bsdf, &batch, 0..n));
+            for (g, w) in got.iter().flatten().zip(want.iter().flatten()) {
+                assert!((g - w).abs() <= 1e-14 * w.abs(), "{g} vs {w}");
+            }
+        };
+        #[cfg(target_arch = "x86_64")]
+        {
+            if let Some(v3) = pulp::x86::V3::try_new() {
+                check(&|r| v3.vectorize(|| sums_on(v3, &bsdf, &batch, r)));
+            }
+            if let Some(v4) = pulp::x86::V4::try_new() {
+                check(&|r| v4.vectorize(|| sums_on(v4, &bsdf, &batch, r)));
+            }
+        }
+    }
+}
