@@ -8,8 +8,10 @@
 #    target/golden-peer.csv). Each round runs the lean brtf, the full brtf
 #    and one scipy fit (the scipy process stays up, --serve), so all three
 #    see the same machine conditions; it prints the medians over the rounds
-#    (ROUNDS, default 7) and the ratios scipy / brtf. The summary also goes
-#    to target/bench-whole-process.txt.
+#    (ROUNDS, default 7) and the ratios scipy / brtf, and for the brtf runs
+#    also the CPU time (user + sys of the process), which other load on
+#    the machine changes far less than the wall time. The summary also
+#    goes to target/bench-whole-process.txt.
 # 2. Unless --whole-only is given: the criterion benches of one fit on
 #    120 000 synthetic points, then `vs_scipy`, which alternates brtf fits
 #    (two threads and one) with scipy fits and prints the best times, the
@@ -35,7 +37,7 @@ BRTF_PEER_CSV="$PWD/target/golden-peer.csv" cargo test --quiet --test cli speed:
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 ROUNDS="${ROUNDS:-7}" .venv/bin/python - "$golden" "$work" <<'EOF' | tee target/bench-whole-process.txt
-import os, statistics, subprocess, sys, time
+import os, resource, statistics, subprocess, sys, time
 
 golden, work = sys.argv[1], sys.argv[2]
 rounds = int(os.environ["ROUNDS"])
@@ -48,16 +50,23 @@ peer = subprocess.Popen([sys.executable, "scripts/scipy_peer.py", "--serve", "ta
 assert peer.stdout.readline().strip() == "ready"
 
 
-def run(command):
+cpu = {"lean": [], "full": []}
+
+
+def run(key, command):
+    used = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     subprocess.run(command, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    return time.perf_counter() - t0
+    wall = time.perf_counter() - t0
+    now = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu[key].append(now.ru_utime - used.ru_utime + now.ru_stime - used.ru_stime)
+    return wall
 
 
 times = {"lean": [], "full": [], "scipy": []}
 for _ in range(rounds):
-    times["lean"].append(run(lean))
-    times["full"].append(run(full))
+    times["lean"].append(run("lean", lean))
+    times["full"].append(run("full", full))
     peer.stdin.write("fit\n")
     peer.stdin.flush()
     times["scipy"].append(float(peer.stdout.readline().split()[0]) / 1e3)
@@ -71,7 +80,10 @@ print(f"whole process on golden_paper.txt (127 039 rows), {rounds} rounds, "
 for key, label in [("lean", "brtf fit --no-plots --no-export"), ("full", "brtf fit (all outputs)"),
                    ("scipy", "scipy least_squares alone")]:
     v = sorted(times[key])
-    print(f"  {label:34s} median {1e3 * med[key]:8.1f} ms  (min {1e3 * v[0]:.1f}, max {1e3 * v[-1]:.1f})")
+    line = f"  {label:34s} median {1e3 * med[key]:8.1f} ms  (min {1e3 * v[0]:.1f}, max {1e3 * v[-1]:.1f})"
+    if key in cpu:
+        line += f"; CPU median {1e3 * statistics.median(cpu[key]):.1f} ms"
+    print(line)
 print(f"  ratio scipy / brtf lean: {med['scipy'] / med['lean']:.1f}x;"
       f" scipy / brtf with all outputs: {med['scipy'] / med['full']:.1f}x")
 EOF

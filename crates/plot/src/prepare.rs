@@ -22,6 +22,7 @@ use brtf_fit::{FitReport, FitResult, InputFile, PreparedMeasurement, Recipe};
 use brtf_gonio::Hemisphere;
 use brtf_model::Bsdf;
 use glam::DVec3;
+use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
@@ -86,6 +87,8 @@ pub struct Incidence {
     pub warnings: Vec<String>,
     /// Nearest-sample grids of the front and back disks, made when first needed.
     coverage: [OnceLock<Coverage>; 2],
+    /// The samples near the plane of incidence, for the cuts.
+    near_plane: OnceLock<Vec<(f64, f64, usize)>>,
 }
 
 impl Incidence {
@@ -113,6 +116,16 @@ impl Incidence {
                 disk::radius_of(disk::FILL_DEG),
             )
         })
+    }
+
+    /// The samples near the plane of incidence, `(offset from the plane,
+    /// in-plane angle, index into samples)` as the cuts define them
+    /// ([`crate::charts::cut::CutData`]): made by `make` on first use.
+    pub(crate) fn near_plane(
+        &self,
+        make: impl FnOnce() -> Vec<(f64, f64, usize)>,
+    ) -> &[(f64, f64, usize)] {
+        self.near_plane.get_or_init(make)
     }
 
     /// Model value `scale × f` (channel mean) for direction `v`.
@@ -234,39 +247,54 @@ fn build(
 
     let floor = report.floor;
     let floor2 = floor * floor;
-    let mut sum_rel = 0.0;
-    let mut n_used = 0usize;
-    let samples: Vec<PlotSample> = m
+    // Every sample with the model next to it, in parallel; the squared
+    // relative errors of the fitted ones (per channel) are summed
+    // afterwards in sample order.
+    let rows: Vec<(PlotSample, Option<[f64; 3]>)> = m
         .samples
-        .iter()
+        .par_iter()
         .zip(removed_by)
         .enumerate()
+        .with_min_len(4096)
         .map(|(i, (s, removed))| {
             let dir = s.direction();
             // Patch-averaged (Klems) data are compared with the averaged model.
             let f = prepared.model_value(&bsdf, i);
             let mut data = 0.0;
             let mut model = 0.0;
-            for (&y, &fc) in s.values.iter().zip(&f).take(channels) {
+            let mut rel = [0.0; 3];
+            for (c, (&y, &fc)) in s.values.iter().zip(&f).take(channels).enumerate() {
                 let mv = report.scale * fc;
                 if removed.is_none() {
                     let e = mv - y;
-                    sum_rel += e * e / (y * y + floor2);
+                    rel[c] = e * e / (y * y + floor2);
                 }
                 data += y;
                 model += mv;
             }
-            if removed.is_none() {
-                n_used += 1;
-            }
-            PlotSample {
+            let sample = PlotSample {
                 theta: s.theta_deg,
                 phi: s.phi_deg,
                 dir,
                 data: data / channels as f64,
                 model: model / channels as f64,
                 removed_by: *removed,
+            };
+            (sample, removed.is_none().then_some(rel))
+        })
+        .collect();
+    let mut sum_rel = 0.0;
+    let mut n_used = 0usize;
+    let samples: Vec<PlotSample> = rows
+        .into_iter()
+        .map(|(sample, rel)| {
+            if let Some(rel) = rel {
+                for r in rel.iter().take(channels) {
+                    sum_rel += r;
+                }
+                n_used += 1;
             }
+            sample
         })
         .collect();
     if n_used != report.n_points {
@@ -304,6 +332,7 @@ fn build(
         channels,
         warnings,
         coverage: Default::default(),
+        near_plane: OnceLock::new(),
     };
     // The nearest-sample grids now, with every thread: the map's SVG and
     // PNG and the reflectance chart all need them, and drawn in parallel

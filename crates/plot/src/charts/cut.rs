@@ -20,6 +20,7 @@ use crate::prepare::{Incidence, PlotSample};
 use glam::DVec3;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
+use rayon::prelude::*;
 
 /// Plane tolerances tried, degrees.
 const TOLERANCES: [f64; 6] = [0.25, 0.5, 1.0, 1.5, 2.0, 3.0];
@@ -105,12 +106,21 @@ impl<'a> CutData<'a> {
     /// Picks the samples near the plane and evaluates the model along it.
     pub fn of(inc: &'a Incidence, tolerance: Option<f64>) -> CutData<'a> {
         let plane = Plane::of(inc);
+        // Made once per incidence: the cut's SVG and PNG and the chart of
+        // all cuts each need them.
         let near: Vec<(f64, f64, &PlotSample)> = inc
-            .samples
+            .near_plane(|| {
+                inc.samples
+                    .par_iter()
+                    .enumerate()
+                    .with_min_len(4096)
+                    .filter(|(_, s)| s.dir.is_finite())
+                    .map(|(k, s)| (plane.offset(s.dir), plane.x_of(s.dir), k))
+                    .filter(|(o, _, _)| *o <= TOLERANCES[TOLERANCES.len() - 1])
+                    .collect()
+            })
             .iter()
-            .filter(|s| s.dir.is_finite())
-            .map(|s| (plane.offset(s.dir), plane.x_of(s.dir), s))
-            .filter(|(o, _, _)| *o <= TOLERANCES[TOLERANCES.len() - 1])
+            .map(|&(o, x, k)| (o, x, &inc.samples[k]))
             .collect();
         // The smallest tolerance with enough fitted samples that also covers
         // (in 2° bins of x) nearly all of what the widest one covers.

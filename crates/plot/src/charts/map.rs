@@ -17,6 +17,7 @@ use brtf_gonio::Hemisphere;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, VPos};
+use rayon::prelude::*;
 use std::sync::{Arc, Mutex, OnceLock};
 
 /// Side of one hemisphere's square in pixels.
@@ -45,6 +46,8 @@ pub struct MapChart<'a> {
     /// The rasters drawn so far, by hemisphere and size: the SVG and the
     /// PNG (drawn at the same time) share them.
     rasters: Mutex<Vec<(RasterKey, SharedRaster)>>,
+    /// Every sample's colour, made once for all rasters.
+    colours: OnceLock<Vec<[u8; 3]>>,
 }
 
 impl<'a> MapChart<'a> {
@@ -56,6 +59,7 @@ impl<'a> MapChart<'a> {
             ratio,
             rms_rel,
             rasters: Mutex::new(Vec::new()),
+            colours: OnceLock::new(),
         }
     }
 
@@ -99,7 +103,14 @@ impl<'a> MapChart<'a> {
     fn paint(&self, hemisphere: Hemisphere, size: u32) -> Vec<u8> {
         let owner = self.inc.coverage(hemisphere).resampled(size);
         // One colour per sample (a logarithm each), looked up per pixel.
-        let colours: Vec<[u8; 3]> = self.inc.samples.iter().map(|s| self.colour_of(s)).collect();
+        let colours = self.colours.get_or_init(|| {
+            self.inc
+                .samples
+                .par_iter()
+                .with_min_len(4096)
+                .map(|s| self.colour_of(s))
+                .collect()
+        });
         let mut rgba = vec![0u8; owner.len() * 4];
         for (px, &o) in rgba.chunks_exact_mut(4).zip(&owner) {
             if o != disk::NONE {
