@@ -136,11 +136,13 @@ fn klems_pairs() -> (Vec<DVec3>, Vec<DVec3>) {
 }
 
 /// What a fit to patch averages does on every iteration: the sums of `f`
-/// and its gradient over runs of `RUN` pairs, the geometry precomputed.
-/// `scalar`: `eval_geometry_channels_with_gradient` per pair; `batch`:
-/// `sum_geometry_with_gradient` per run. Rates are pairs per second.
+/// and its gradient over runs of pairs, the geometry precomputed.
+/// `scalar`: `eval_geometry_channels_with_gradient::<CH>` per pair, summed;
+/// `batch`: `sum_geometry_with_gradient::<CH>` per run. Rates are pairs per
+/// second. `{type}/*`: one channel (a grey fit), runs of 128 pairs;
+/// `trans_rgb/*`: three channels; `trans_run32/*`: runs of 32 pairs (the
+/// shortest a Klems sample has).
 fn bench_patch_sum(c: &mut Criterion) {
-    const RUN: usize = 128;
     let (lights, views) = klems_pairs();
     let mut group = c.benchmark_group("patch_sum");
     group.throughput(Throughput::Elements(PATCH_PAIRS as u64));
@@ -149,52 +151,67 @@ fn bench_patch_sum(c: &mut Criterion) {
         MaterialKind::Plastic,
         MaterialKind::Trans,
     ] {
-        let bsdf = Bsdf::new(&material(kind), &EvalOptions::default());
-        let geometry: Vec<Geometry> = lights
-            .iter()
-            .zip(&views)
-            .map(|(&l, &v)| bsdf.geometry(l, v))
-            .collect();
-        let mut batch = GeometryBatch::new();
-        bsdf.geometry_batch(&lights, &views, &mut batch);
-        let name = kind.name();
-        group.bench_function(format!("{name}/scalar"), |b| {
-            let (mut grad, mut grad_sum) = (Gradient::default(), Gradient::default());
-            b.iter(|| {
-                let mut total = 0.0;
-                for run in geometry.chunks(RUN) {
-                    let mut f_sum = 0.0;
-                    grad_sum.d = [[0.0; 3]; 8];
-                    for g in run {
-                        f_sum += black_box(&bsdf)
-                            .eval_geometry_channels_with_gradient::<1>(g, &mut grad)[0];
+        patch_sum_pair::<1>(&mut group, kind, kind.name(), 128, &lights, &views);
+    }
+    let trans = MaterialKind::Trans;
+    patch_sum_pair::<3>(&mut group, trans, "trans_rgb", 128, &lights, &views);
+    patch_sum_pair::<1>(&mut group, trans, "trans_run32", 32, &lights, &views);
+    group.finish();
+}
+
+/// `patch_sum/{name}/scalar` and `patch_sum/{name}/batch`.
+fn patch_sum_pair<const CH: usize>(
+    group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    kind: MaterialKind,
+    name: &str,
+    run: usize,
+    lights: &[DVec3],
+    views: &[DVec3],
+) {
+    let bsdf = Bsdf::new(&material(kind), &EvalOptions::default());
+    let geometry: Vec<Geometry> = lights
+        .iter()
+        .zip(views)
+        .map(|(&l, &v)| bsdf.geometry(l, v))
+        .collect();
+    let mut batch = GeometryBatch::new();
+    bsdf.geometry_batch(lights, views, &mut batch);
+    group.bench_function(format!("{name}/scalar"), |b| {
+        let (mut grad, mut grad_sum) = (Gradient::default(), Gradient::default());
+        b.iter(|| {
+            let mut total = 0.0;
+            for pairs in geometry.chunks(run) {
+                let mut f_sum = [0.0; 3];
+                grad_sum.d = [[0.0; 3]; 8];
+                for g in pairs {
+                    let f =
+                        black_box(&bsdf).eval_geometry_channels_with_gradient::<CH>(g, &mut grad);
+                    for ch in 0..CH {
+                        f_sum[ch] += f[ch];
                         for (s, d) in grad_sum.d.iter_mut().zip(&grad.d) {
-                            s[0] += d[0];
+                            s[ch] += d[ch];
                         }
                     }
-                    total += f_sum + grad_sum.d[4][0];
                 }
-                total
-            })
-        });
-        group.bench_function(format!("{name}/batch"), |b| {
-            let mut grad_sum = Gradient::default();
-            b.iter(|| {
-                let mut total = 0.0;
-                for start in (0..PATCH_PAIRS).step_by(RUN) {
-                    let range = start..(start + RUN).min(PATCH_PAIRS);
-                    total += black_box(&bsdf).sum_geometry_with_gradient::<1>(
-                        &batch,
-                        range,
-                        &mut grad_sum,
-                    )[0];
-                    total += grad_sum.d[4][0];
-                }
-                total
-            })
-        });
-    }
-    group.finish();
+                total += f_sum[0] + grad_sum.d[4][0];
+            }
+            total
+        })
+    });
+    group.bench_function(format!("{name}/batch"), |b| {
+        let mut grad_sum = Gradient::default();
+        b.iter(|| {
+            let mut total = 0.0;
+            for start in (0..geometry.len()).step_by(run) {
+                let range = start..(start + run).min(geometry.len());
+                total +=
+                    black_box(&bsdf).sum_geometry_with_gradient::<CH>(&batch, range, &mut grad_sum)
+                        [0];
+                total += grad_sum.d[4][0];
+            }
+            total
+        })
+    });
 }
 
 fn bench_albedo(c: &mut Criterion) {
