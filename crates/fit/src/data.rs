@@ -84,33 +84,50 @@ pub struct IncidenceData {
 /// patch, so the model must be averaged the same way to be compared with
 /// them. Pairs are fixed when the data are prepared, so the objective is a
 /// smooth function of the parameters.
+///
+/// A Klems side has ~10 million pairs but only a few thousand distinct
+/// directions, so pairs are stored as two indices into a direction table
+/// (8 bytes a pair instead of 48).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct PatchPairs {
     /// Start of sample i's pairs is `offsets[i]`, its end `offsets[i + 1]`.
     pub offsets: Vec<usize>,
-    /// Unit vectors towards the light, one per pair.
-    pub lights: Vec<DVec3>,
-    /// Unit vectors towards the detector, one per pair.
-    pub views: Vec<DVec3>,
+    /// The unit vectors the pairs use.
+    pub directions: Vec<DVec3>,
+    /// Per pair, the index in `directions` of the vector towards the light.
+    pub light_index: Vec<u32>,
+    /// Per pair, the index in `directions` of the vector towards the
+    /// detector.
+    pub view_index: Vec<u32>,
 }
 
 impl PatchPairs {
-    /// No samples yet.
-    pub fn new() -> PatchPairs {
+    /// No samples yet; pairs will index `directions`.
+    pub fn new(directions: Vec<DVec3>) -> PatchPairs {
         PatchPairs {
             offsets: vec![0],
-            lights: Vec::new(),
-            views: Vec::new(),
+            directions,
+            light_index: Vec::new(),
+            view_index: Vec::new(),
         }
     }
 
-    /// Appends one sample's pairs.
-    pub fn push(&mut self, pairs: impl IntoIterator<Item = (DVec3, DVec3)>) {
+    /// Appends one sample's pairs, as (light, view) indices into
+    /// `directions`.
+    ///
+    /// # Panics
+    /// If an index is outside `directions`.
+    pub fn push(&mut self, pairs: impl IntoIterator<Item = (u32, u32)>) {
+        let n = self.directions.len();
         for (light, view) in pairs {
-            self.lights.push(light);
-            self.views.push(view);
+            assert!(
+                (light as usize) < n && (view as usize) < n,
+                "PatchPairs::push: index outside the {n} directions"
+            );
+            self.light_index.push(light);
+            self.view_index.push(view);
         }
-        self.offsets.push(self.lights.len());
+        self.offsets.push(self.light_index.len());
     }
 
     /// How many samples.
@@ -123,34 +140,45 @@ impl PatchPairs {
         self.len() == 0
     }
 
-    /// The pairs of sample `i`: (lights, views).
+    /// How many pairs in all.
+    pub fn pair_count(&self) -> usize {
+        self.light_index.len()
+    }
+
+    /// The pairs of sample `i`, as (light, view) vectors.
     #[inline]
-    pub fn of(&self, i: usize) -> (&[DVec3], &[DVec3]) {
+    pub fn of(&self, i: usize) -> impl ExactSizeIterator<Item = (DVec3, DVec3)> + '_ {
         let range = self.offsets[i]..self.offsets[i + 1];
-        (&self.lights[range.clone()], &self.views[range])
+        self.light_index[range.clone()]
+            .iter()
+            .zip(&self.view_index[range])
+            .map(|(&l, &v)| (self.directions[l as usize], self.directions[v as usize]))
     }
 
     /// The pairs of the samples `indices`, in that order.
     pub fn select(&self, indices: impl IntoIterator<Item = usize>) -> PatchPairs {
-        let mut out = PatchPairs::new();
+        let mut out = PatchPairs::new(self.directions.clone());
         for i in indices {
-            let (lights, views) = self.of(i);
-            out.push(lights.iter().copied().zip(views.iter().copied()));
+            let range = self.offsets[i]..self.offsets[i + 1];
+            out.light_index
+                .extend_from_slice(&self.light_index[range.clone()]);
+            out.view_index.extend_from_slice(&self.view_index[range]);
+            out.offsets.push(out.light_index.len());
         }
         out
     }
 
     /// The BSDF of sample `i` averaged over its pairs.
     pub fn average(&self, bsdf: &brtf_model::Bsdf, i: usize) -> [f64; 3] {
-        let (lights, views) = self.of(i);
+        let pairs = self.of(i);
+        let n = pairs.len().max(1) as f64;
         let mut sum = [0.0; 3];
-        for (l, v) in lights.iter().zip(views) {
-            let f = bsdf.eval(*l, *v);
+        for (l, v) in pairs {
+            let f = bsdf.eval(l, v);
             for (s, x) in sum.iter_mut().zip(f) {
                 *s += x;
             }
         }
-        let n = lights.len().max(1) as f64;
         sum.map(|s| s / n)
     }
 }

@@ -34,7 +34,7 @@ const POLISH_SAMPLES: usize = 2000;
 const CANDIDATES: usize = 3;
 /// Most patch pairs whose geometry a fit keeps (48 bytes each): one Klems
 /// incidence has ~50 000.
-const GEOMETRY_CACHE_PAIRS: usize = 2_000_000;
+const GEOMETRY_CACHE_PAIRS: usize = 12_000_000;
 /// Robust reweighting stops when no parameter moves by more than this
 /// (relative) in a round...
 const IRLS_TOLERANCE: f64 = 1e-6;
@@ -246,7 +246,7 @@ fn attach_pair_geometry(blocks: &mut [Block<'_>], config: &FitConfig) -> Result<
     let pairs: usize = blocks
         .iter()
         .filter_map(|b| b.pairs.as_ref())
-        .map(|p| p.lights.len())
+        .map(|p| p.pair_count())
         .sum();
     if pairs == 0 || pairs > GEOMETRY_CACHE_PAIRS {
         return Ok(());

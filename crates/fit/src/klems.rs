@@ -107,7 +107,9 @@ fn patch_pairs(
             p.stratified_directions(rule.outgoing_samples, &mut Rng::new(rule.seed, o as u64))
         })
         .collect();
-    let mut pairs = PatchPairs::new();
+    // The direction table: the lights, then each sample's views.
+    let n_lights = lights.len() as u32;
+    let mut pairs = PatchPairs::new(lights.clone());
     for sample in &prepared.measurement.samples {
         let transmitted = sample.theta_deg > 90.0;
         let theta = if transmitted {
@@ -126,7 +128,11 @@ fn patch_pairs(
                 v
             }
         };
-        let views: Vec<DVec3> = outgoing[o].iter().copied().map(to_side).collect();
+        let first_view = pairs.directions.len() as u32;
+        pairs
+            .directions
+            .extend(outgoing[o].iter().copied().map(to_side));
+        let n_views = pairs.directions.len() as u32 - first_view;
         // The lobe's centre for this side: the mirror direction, or the
         // straight-through direction (the mirror's reflection through the
         // surface).
@@ -134,17 +140,10 @@ fn patch_pairs(
         let near = sample.direction().dot(lobe) >= near_cosine;
         if near || lights.is_empty() {
             pairs.push(
-                lights
-                    .iter()
-                    .flat_map(|&l| views.iter().map(move |&v| (l, v))),
+                (0..n_lights).flat_map(|l| (first_view..first_view + n_views).map(move |v| (l, v))),
             );
         } else {
-            pairs.push(
-                views
-                    .iter()
-                    .enumerate()
-                    .map(|(k, &v)| (lights[k % lights.len()], v)),
-            );
+            pairs.push((0..n_views).map(|k| (k % n_lights, first_view + k)));
         }
     }
     pairs

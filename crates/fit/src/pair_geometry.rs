@@ -26,8 +26,10 @@ impl PairGeometry {
     /// The geometry of every pair of `pairs` under `bsdf`'s type,
     /// orientation and options (its arguments do not matter).
     pub(crate) fn new(pairs: &PatchPairs, bsdf: &Bsdf) -> PairGeometry {
-        let mut geometry = GeometryBatch::with_capacity(pairs.lights.len());
-        bsdf.geometry_batch(&pairs.lights, &pairs.views, &mut geometry);
+        let mut geometry = GeometryBatch::with_capacity(pairs.pair_count());
+        for i in 0..pairs.len() {
+            geometry.extend(pairs.of(i).map(|(l, v)| bsdf.geometry(l, v)));
+        }
         PairGeometry {
             offsets: pairs.offsets.clone(),
             geometry,

@@ -496,10 +496,10 @@ impl Kernel<'_> {
         match (&block.pair_geometry, &block.pairs) {
             (Some(cached), _) => (&cached.geometry, cached.range(i)),
             (None, Some(pairs)) => {
-                let (lights, views) = pairs.of(i);
                 scratch.clear();
-                self.bsdf.geometry_batch(lights, views, scratch);
-                (&*scratch, 0..lights.len())
+                scratch.extend(pairs.of(i).map(|(l, v)| self.bsdf.geometry(l, v)));
+                let n = scratch.len();
+                (&*scratch, 0..n)
             }
             (None, None) => unreachable!("patch-averaged blocks have pairs"),
         }
