@@ -327,6 +327,17 @@ fn real_fabric_both_sides_converge_and_are_reported_side_by_side() {
                 "{side} {}: {termination}",
                 i["source"]
             );
+            // Parameters at a bound have no standard error; the others
+            // have a finite, positive one (a singular JᵀJ once gave all of
+            // them exactly 0 or none at all).
+            for p in i["params"].as_array().unwrap() {
+                if p["at_bound"] == true || p["fixed"] == true {
+                    assert!(p["stderr"].is_null(), "{side}: {p}");
+                } else {
+                    let e = p["stderr"].as_f64();
+                    assert!(e.is_some_and(|e| e > 0.0 && e < 1.0), "{side}: {p}");
+                }
+            }
         }
         let inputs = json["provenance"]["inputs"].as_array().unwrap();
         assert!(inputs.iter().all(|i| i["klems"]["side"] == side), "{side}");
