@@ -355,3 +355,62 @@ fn real_fabric_both_sides_converge_and_are_reported_side_by_side() {
     assert_eq!(report.matches("<figure><svg").count(), 8);
     assert!(!report.contains("cannot be shown"), "{report}");
 }
+
+/// A Klems side has many incidences: the summary lists the file once and
+/// the warnings by kind, each with its count, θ_in range and one example,
+/// instead of every incidence's warnings (a one-sided SA1 fit printed
+/// 1 061 lines, now 317).
+#[test]
+fn many_incidences_give_warnings_by_kind() {
+    let tmp = temp_dir();
+    let out = tmp.path().join("sa1");
+    let printed = brtf(
+        &[
+            "fit",
+            s(&fabric("2011-SA1.xml")),
+            "--model",
+            "trans",
+            "--gray",
+            "--side",
+            "front",
+            "--incidences",
+            "theta<=20",
+            "--no-plots",
+            "--no-export",
+            "--no-adequacy",
+            "--out",
+            s(&out),
+        ],
+        "",
+    )
+    .ok();
+    assert!(
+        printed.contains("2011-SA1.xml: 25 incidences, θ_in 0–20°, 290 samples each"),
+        "{printed}"
+    );
+    assert!(
+        printed.contains("warnings, by kind (25 incidences"),
+        "{printed}"
+    );
+    // SA1 has no specular reflection: its specularity sits at 0 on every
+    // incidence, said once with its count.
+    assert!(
+        printed.contains("spec ended at a bound: 25 incidences, θ_in 0–20°"),
+        "{printed}"
+    );
+    assert_eq!(
+        printed.matches("ended at a bound: ").count(),
+        2,
+        "{printed}"
+    );
+    // fit.json keeps every incidence's own warnings.
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("fit.json")).unwrap()).unwrap();
+    let incidences = json["incidences"].as_array().unwrap();
+    assert_eq!(incidences.len(), 25);
+    assert!(
+        incidences
+            .iter()
+            .all(|i| i["warnings"].as_array().is_some_and(|w| !w.is_empty()))
+    );
+}

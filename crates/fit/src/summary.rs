@@ -19,12 +19,16 @@ pub fn summary(result: &FitResult, out: &Path) -> String {
         result.incidences.len(),
         out.display()
     );
-    for i in &result.provenance.inputs {
-        let _ = writeln!(
-            s,
-            "  {}: θ_in {}°, φ_in {}°, {} samples, {}",
-            i.path, i.theta_in, i.phi_in, i.samples, i.conversion
-        );
+    if result.provenance.inputs.len() > GROUP_ABOVE {
+        inputs_by_file(&mut s, result);
+    } else {
+        for i in &result.provenance.inputs {
+            let _ = writeln!(
+                s,
+                "  {}: θ_in {}°, φ_in {}°, {} samples, {}",
+                i.path, i.theta_in, i.phi_in, i.samples, i.conversion
+            );
+        }
     }
     let names: Vec<&str> = result
         .incidences
@@ -80,13 +84,17 @@ pub fn summary(result: &FitResult, out: &Path) -> String {
         .map(|r| (r, format!("{} (θ_in {})", r.source, r.theta_in)))
         .chain(global.map(|r| (r, "all incidences".to_string())));
     // The set's own warnings go to stderr (the CLI prints them).
-    let warnings: Vec<String> = labelled
-        .flat_map(|(r, label)| r.warnings.iter().map(move |w| format!("{label}: {w}")))
-        .collect();
-    if !warnings.is_empty() {
-        let _ = writeln!(s, "\nwarnings:");
-        for w in &warnings {
-            let _ = writeln!(s, "  {w}");
+    if result.incidences.len() > GROUP_ABOVE {
+        grouped_warnings(&mut s, result);
+    } else {
+        let warnings: Vec<String> = labelled
+            .flat_map(|(r, label)| r.warnings.iter().map(move |w| format!("{label}: {w}")))
+            .collect();
+        if !warnings.is_empty() {
+            let _ = writeln!(s, "\nwarnings:");
+            for w in &warnings {
+                let _ = writeln!(s, "  {w}");
+            }
         }
     }
     if let Some(g) = &result.global {
@@ -100,6 +108,106 @@ pub fn summary(result: &FitResult, out: &Path) -> String {
         );
     }
     s
+}
+
+/// Above this many incidences (a Klems side has 145) the inputs are listed
+/// per file and the warnings per kind: the same three warnings on every
+/// incidence would otherwise bury the table. fit.json and the report keep
+/// every incidence's own list.
+const GROUP_ABOVE: usize = 12;
+
+/// One line per input file: how many incidences it gave, over which θ_in.
+fn inputs_by_file(s: &mut String, result: &FitResult) {
+    let mut files: Vec<(&str, Vec<&crate::InputFile>)> = Vec::new();
+    for i in &result.provenance.inputs {
+        match files.iter_mut().find(|(path, _)| *path == i.path) {
+            Some((_, list)) => list.push(i),
+            None => files.push((&i.path, vec![i])),
+        }
+    }
+    for (path, list) in files {
+        let (lo, hi) = range(list.iter().map(|i| i.theta_in));
+        let (fewest, most) = range(list.iter().map(|i| i.samples as f64));
+        let samples = if fewest == most {
+            format!("{fewest} samples each")
+        } else {
+            format!("{fewest}–{most} samples")
+        };
+        let _ = writeln!(
+            s,
+            "  {path}: {} incidences, θ_in {lo}–{hi}°, {samples}, {}",
+            list.len(),
+            list[0].conversion
+        );
+    }
+}
+
+/// The smallest and largest of `values`.
+fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+        (lo.min(v), hi.max(v))
+    })
+}
+
+/// The incidences' warnings grouped by kind (and parameter): how many
+/// incidences, over which θ_in, and one example in full; then the
+/// all-incidence fit's own.
+fn grouped_warnings(s: &mut String, result: &FitResult) {
+    // (kind, incidences with it, θ_in range, first example)
+    let mut groups: Vec<(String, usize, (f64, f64), String)> = Vec::new();
+    for r in &result.incidences {
+        for w in &r.warnings {
+            let kind = warning_kind(w);
+            let example = format!("{} (θ_in {}): {w}", r.source, r.theta_in);
+            match groups.iter_mut().find(|g| g.0 == kind) {
+                Some(g) => {
+                    g.1 += 1;
+                    g.2 = (g.2.0.min(r.theta_in), g.2.1.max(r.theta_in));
+                }
+                None => groups.push((kind, 1, (r.theta_in, r.theta_in), example)),
+            }
+        }
+    }
+    let global: Vec<String> = result
+        .global
+        .iter()
+        .filter(|_| result.incidences.len() > 1)
+        .flat_map(|g| g.warnings.iter().map(|w| format!("all incidences: {w}")))
+        .collect();
+    if groups.is_empty() && global.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        s,
+        "\nwarnings, by kind ({} incidences; each incidence's own are in fit.json and report.html):",
+        result.incidences.len()
+    );
+    for (kind, count, (lo, hi), example) in &groups {
+        let _ = writeln!(s, "  {kind}: {count} incidences, θ_in {lo}–{hi}°");
+        let _ = writeln!(s, "    e.g. {example}");
+    }
+    for w in &global {
+        let _ = writeln!(s, "  {w}");
+    }
+}
+
+/// What a warning is about, without its numbers.
+fn warning_kind(w: &crate::FitWarning) -> String {
+    use crate::FitWarning as W;
+    match w {
+        W::AtBound { param, .. } => format!("{param} ended at a bound"),
+        W::FreeScaleColour => "free scale: colour and scale are one product".into(),
+        W::UnderstatedErrors { .. } => "standard errors understated".into(),
+        W::DegenerateLobe => "specularity ≈ 0: degenerate lobe".into(),
+        W::NotConverged { .. } => "not converged".into(),
+        W::RobustNotSettled { .. } => "robust reweighting not settled".into(),
+        W::EnergyMismatch { .. } => "data and model ρ_dh/τ_dh differ".into(),
+        W::PeakOffset { .. } => "model peak away from the data's".into(),
+        W::ResidualKindSensitive { check } => format!(
+            "{} moves with another residual kind ({:?})",
+            check.param, check.residual
+        ),
+    }
 }
 
 /// The adequacy diagnostics, one line per incidence that has them.
