@@ -212,7 +212,9 @@ fn run_klems(args: ExportArgs) -> Result<()> {
     }
 
     let dir = args.dir.context("give the fit folder or --material")?;
-    let front = if dir.join("front").join("fit.json").is_file() {
+    // A two-sided Klems fit: front/ and back/ inside `dir`.
+    let two_sided = dir.join("front").join("fit.json").is_file();
+    let front = if two_sided {
         dir.join("front").join("fit.json")
     } else {
         dir.join("fit.json")
@@ -220,7 +222,8 @@ fn run_klems(args: ExportArgs) -> Result<()> {
     let result = FitResult::read(&front)?;
     let name = match &args.name {
         Some(n) => n.clone(),
-        None if front.ends_with("front/fit.json") => dir
+        // (A side's own folder, `…/front`, is named by its fit.)
+        None if two_sided => dir
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_else(|| result.name.clone()),

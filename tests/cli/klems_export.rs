@@ -518,4 +518,17 @@ fn two_sided_fit_folder_exports_four_components() {
             }
         }
     }
+    // One side's own folder is named by its fit, not by the folder: it
+    // was written as `front/front.xml`, named "front".
+    let printed = brtf(&["export", s(&two.join("front")), "--klems", "quarter"], "").ok();
+    assert!(two.join("front/grey.xml").is_file(), "{printed}");
+    assert!(!two.join("front/front.xml").exists(), "{printed}");
+    assert_eq!(
+        klems::read_path(&two.join("front/grey.xml"))
+            .unwrap()
+            .header
+            .name
+            .as_deref(),
+        Some("grey")
+    );
 }
