@@ -135,26 +135,28 @@ impl RgbBatch {
 
 /// The per-material numbers the kernel reads, copied out of [`Bsdf`].
 #[derive(Debug, Clone, Copy)]
-struct Constants {
-    color: [f64; 3],
-    spec: f64,
-    trans: f64,
-    tspec: f64,
-    fresnel_k: f64,
+pub(crate) struct Constants {
+    pub(crate) color: [f64; 3],
+    pub(crate) spec: f64,
+    pub(crate) trans: f64,
+    pub(crate) tspec: f64,
+    pub(crate) fresnel_k: f64,
     /// 1/(α² + widening) of the reflected lobe along û and v̂.
-    inv_wu: f64,
-    inv_wv: f64,
+    pub(crate) inv_wu: f64,
+    pub(crate) inv_wv: f64,
     /// `sqrt(inv_wu inv_wv)`.
-    inv_w_root: f64,
+    pub(crate) inv_w_root: f64,
     /// α² + ω/π of the transmitted lobe along û and v̂.
-    bu: f64,
-    bv: f64,
+    pub(crate) bu: f64,
+    pub(crate) bv: f64,
     /// `sqrt(bu bv)`.
-    b_root: f64,
-    pure: bool,
-    metal: bool,
-    frame_u: [f64; 3],
-    frame_v: [f64; 3],
+    pub(crate) b_root: f64,
+    /// ∂(α²_u, α²_v)/∂(a_u, a_v), for the gradient sums (`batch_gradient`).
+    pub(crate) dalpha2: [[f64; 2]; 2],
+    pub(crate) pure: bool,
+    pub(crate) metal: bool,
+    pub(crate) frame_u: [f64; 3],
+    pub(crate) frame_v: [f64; 3],
 }
 
 pub(crate) const RADIANCE: u8 = 0;
@@ -231,7 +233,8 @@ impl Bsdf {
         }
     }
 
-    fn batch_constants(&self) -> Constants {
+    /// The material's numbers every batch kernel needs.
+    pub(crate) fn batch_constants(&self) -> Constants {
         let (inv_wu, inv_wv) = self.reflect_inv_width();
         let (bu, bv) = self.transmit_width();
         let (fu, fv) = self.tangent_frame();
@@ -247,6 +250,7 @@ impl Bsdf {
             bu,
             bv,
             b_root: (bu * bv).sqrt(),
+            dalpha2: self.width_derivatives(),
             pure: self.is_pure(),
             metal: self.kind().is_metal(),
             frame_u: fu.to_array(),

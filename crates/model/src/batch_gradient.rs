@@ -29,7 +29,7 @@
 
 #![allow(clippy::needless_range_loop)] // channel and lane loops index several arrays at once
 
-use crate::batch::{MANUAL2004, RADIANCE, WARD1992};
+use crate::batch::{Constants, MANUAL2004, RADIANCE, WARD1992};
 use crate::bsdf::{Bsdf, Geometry, Gradient, Rgb};
 use crate::kind::Variant;
 use crate::material::FTINY;
@@ -173,30 +173,6 @@ struct Columns<'a> {
     cutoff_factor: &'a [f64],
 }
 
-/// The per-material numbers the kernel reads, copied out of [`Bsdf`].
-#[derive(Debug, Clone, Copy)]
-struct Constants {
-    color: [f64; 3],
-    spec: f64,
-    trans: f64,
-    tspec: f64,
-    fresnel_k: f64,
-    /// 1/(α² + widening) of the reflected lobe along û and v̂.
-    inv_wu: f64,
-    inv_wv: f64,
-    /// `sqrt(inv_wu inv_wv)`.
-    inv_w_root: f64,
-    /// α² + ω/π of the transmitted lobe along û and v̂.
-    bu: f64,
-    bv: f64,
-    /// `sqrt(bu bv)`.
-    b_root: f64,
-    /// ∂(α²_u, α²_v)/∂(a_u, a_v).
-    dalpha2: [[f64; 2]; 2],
-    pure: bool,
-    metal: bool,
-}
-
 impl Bsdf {
     /// Appends the [`Geometry`] of every pair `(lights[i], views[i])` to
     /// `out` (see [`Bsdf::geometry`]).
@@ -266,7 +242,7 @@ impl Bsdf {
     /// Picks the kernel for this material's switches.
     fn sum_dispatch<const GRAD: bool, const CH: usize>(&self, g: Columns) -> [[f64; 3]; ROWS] {
         assert!(CH <= 3, "CH = {CH}: at most 3 channels");
-        let k = self.sum_constants();
+        let k = self.batch_constants();
         let variant = self.options().variant;
         let fresnel = self.has_fresnel();
         macro_rules! run {
@@ -292,27 +268,6 @@ impl Bsdf {
             (false, true) => run!(false, true),
             (true, false) => run!(true, false),
             (true, true) => run!(true, true),
-        }
-    }
-
-    fn sum_constants(&self) -> Constants {
-        let (inv_wu, inv_wv) = self.reflect_inv_width();
-        let (bu, bv) = self.transmit_width();
-        Constants {
-            color: self.material().color(),
-            spec: self.spec_arg(),
-            trans: self.trans_arg(),
-            tspec: self.tspec_arg(),
-            fresnel_k: self.options().fresnel_k,
-            inv_wu,
-            inv_wv,
-            inv_w_root: (inv_wu * inv_wv).sqrt(),
-            bu,
-            bv,
-            b_root: (bu * bv).sqrt(),
-            dalpha2: self.width_derivatives(),
-            pure: self.is_pure(),
-            metal: self.kind().is_metal(),
         }
     }
 }
@@ -898,7 +853,7 @@ mod tests {
         batch: &GeometryBatch,
         range: Range<usize>,
     ) -> [[f64; 3]; ROWS] {
-        let k = bsdf.sum_constants();
+        let k = bsdf.batch_constants();
         let op = SumOp::<true, 3, false, true, RADIANCE, false> {
             k: &k,
             g: batch.columns(range),
