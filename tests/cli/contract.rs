@@ -269,6 +269,29 @@ fn a_parameter_at_a_bound_breaks_no_command() {
         "",
     )
     .ok();
+    // A prefix given with the picture's extension is not doubled
+    // (`--out pic.hdr` wrote pic.hdr.hdr and pic.hdr.png).
+    let named = dir.path().join("named.hdr");
+    brtf(
+        &[
+            "render",
+            "image",
+            "--fit",
+            s(&out),
+            "--out",
+            s(&named),
+            "--width",
+            "8",
+            "--height",
+            "6",
+            "--samples",
+            "1",
+        ],
+        "",
+    )
+    .ok();
+    assert!(named.is_file() && dir.path().join("named.png").is_file());
+    assert!(!dir.path().join("named.hdr.hdr").exists());
 }
 
 /// CIE-XYZ files are fitted in Radiance RGB: a plastic of known colour,

@@ -17,7 +17,8 @@ const D: SceneSpec = SceneSpec::DEFAULT;
 pub struct ImageArgs {
     #[command(flatten)]
     pub sample: SampleMaterial,
-    /// Output prefix: writes PREFIX.hdr (Radiance RGBE) and PREFIX.png.
+    /// Output prefix: writes PREFIX.hdr (Radiance RGBE) and PREFIX.png
+    /// (a trailing .hdr or .png on PREFIX is dropped).
     #[arg(long, value_name = "PREFIX")]
     pub out: PathBuf,
     /// Width in pixels.
@@ -159,9 +160,15 @@ impl ImageArgs {
         }
     }
 
-    /// `PREFIX` + `ext`.
+    /// `PREFIX` + `ext`. A prefix given with one of the outputs'
+    /// extensions (`--out img.hdr`) loses it, so it does not write
+    /// `img.hdr.hdr`.
     fn with_ext(&self, ext: &str) -> PathBuf {
-        let mut p = self.out.clone().into_os_string();
+        let prefix = match self.out.extension().and_then(|e| e.to_str()) {
+            Some("hdr" | "png") => self.out.with_extension(""),
+            _ => self.out.clone(),
+        };
+        let mut p = prefix.into_os_string();
         p.push(ext);
         PathBuf::from(p)
     }
