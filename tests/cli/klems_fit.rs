@@ -356,6 +356,49 @@ fn real_fabric_both_sides_converge_and_are_reported_side_by_side() {
     assert!(!report.contains("cannot be shown"), "{report}");
 }
 
+/// The all-incidence fit of a whole Klems side starts from a subsample
+/// with samples of every incidence. With one or two per incidence, the
+/// Mecho fabric's starts ran to a corner (diffuse reflectance 0, the
+/// transmission at its bound) and the fit ended there at cost 40.9; its
+/// minimum is at 26.1, with both parts inside their bounds.
+#[test]
+fn whole_side_all_incidence_fit_finds_the_interior_minimum() {
+    let tmp = temp_dir();
+    let out = tmp.path().join("mecho");
+    brtf(
+        &[
+            "fit",
+            s(&fabric("klems_aniso_high.xml")),
+            "--model",
+            "trans",
+            "--gray",
+            "--side",
+            "front",
+            "--no-plots",
+            "--no-export",
+            "--no-adequacy",
+            "--out",
+            s(&out),
+        ],
+        "",
+    )
+    .ok();
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("fit.json")).unwrap()).unwrap();
+    let global = &json["global"];
+    let cost = global["cost"].as_f64().unwrap();
+    assert!(cost < 26.2, "all-incidence cost {cost}");
+    for name in ["red", "trans"] {
+        let p = global["params"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|p| p["name"] == name)
+            .unwrap();
+        assert_eq!(p["at_bound"], false, "{p}");
+    }
+}
+
 /// A Klems side has many incidences: the summary lists the file once and
 /// the warnings by kind, each with its count, θ_in range and one example,
 /// instead of every incidence's warnings (a one-sided SA1 fit printed

@@ -4,7 +4,7 @@
 //! and the report with its standard errors.
 
 use crate::config::{FitConfig, FitError, RobustLoss};
-use crate::data::IncidenceData;
+use crate::data::{IncidenceData, PatchPairs};
 use crate::pair_geometry::PairGeometry;
 use crate::params::{ParamMap, Target};
 use crate::prepare;
@@ -25,6 +25,11 @@ use std::time::Instant;
 /// Samples per start in the multi-start phase (every k-th sample, plus
 /// the brightest ones): enough to find a basin.
 const START_SAMPLES: usize = 250;
+/// Fewest samples per incidence in the starts' subsample of an
+/// all-incidence fit: with one or two, the 145 incidences of a Klems side
+/// drove the starts to a corner (diffuse reflectance at 1) that the final
+/// fit took 35 passes over ten million pairs to leave, or never left.
+const START_SAMPLES_PER_INCIDENCE: usize = 16;
 /// The brightest samples every subsample keeps, whatever its stride.
 const BRIGHT_SAMPLES: usize = 250;
 /// Samples of the polish of the best start before the fit on every
@@ -43,19 +48,67 @@ const IRLS_MAX_ROUNDS: usize = 100;
 
 /// Fits one incidence.
 pub fn fit_incidence(data: &IncidenceData, config: &FitConfig) -> Result<FitReport, FitError> {
-    fit_many(std::slice::from_ref(data), config, &data.source)
+    fit_many(std::slice::from_ref(data), config, &data.source, None)
 }
 
 /// Fits one parameter set to all incidences at once. Each incidence gets
 /// the same total weight, so densely sampled files do not dominate.
 pub fn fit_global(data: &[IncidenceData], config: &FitConfig) -> Result<FitReport, FitError> {
-    fit_many(data, config, "all incidences")
+    fit_many(data, config, "all incidences", None)
+}
+
+/// The pair geometry of each of `data`'s incidences, for a fit set whose
+/// per-incidence and all-incidence fits share it: `None` when the data
+/// are not patch averages, or when their pairs exceed the cache budget.
+pub(crate) fn shared_pair_geometry(
+    data: &[IncidenceData],
+    config: &FitConfig,
+) -> Result<Option<Vec<PairGeometry>>, FitError> {
+    let pairs: Option<Vec<&PatchPairs>> = data.iter().map(|d| d.patch_pairs.as_deref()).collect();
+    let Some(pairs) = pairs else {
+        return Ok(None);
+    };
+    let total: usize = pairs.iter().map(|p| p.pair_count()).sum();
+    if total == 0 || total > GEOMETRY_CACHE_PAIRS {
+        return Ok(None);
+    }
+    let bsdf = geometry_bsdf(config)?;
+    Ok(Some(
+        pairs
+            .par_iter()
+            .map(|p| PairGeometry::new(p, &bsdf))
+            .collect(),
+    ))
+}
+
+/// [`fit_incidence`] with the incidence's shared pair geometry.
+pub(crate) fn fit_incidence_sharing(
+    data: &IncidenceData,
+    config: &FitConfig,
+    geometry: Option<&PairGeometry>,
+) -> Result<FitReport, FitError> {
+    fit_many(
+        std::slice::from_ref(data),
+        config,
+        &data.source,
+        geometry.map(std::slice::from_ref),
+    )
+}
+
+/// [`fit_global`] with the incidences' shared pair geometry.
+pub(crate) fn fit_global_sharing(
+    data: &[IncidenceData],
+    config: &FitConfig,
+    geometry: Option<&[PairGeometry]>,
+) -> Result<FitReport, FitError> {
+    fit_many(data, config, "all incidences", geometry)
 }
 
 fn fit_many(
     data: &[IncidenceData],
     config: &FitConfig,
     label: &str,
+    geometry: Option<&[PairGeometry]>,
 ) -> Result<FitReport, FitError> {
     let started = Instant::now();
     let channels = data[0].channels.clamp(1, 3);
@@ -72,13 +125,23 @@ fn fit_many(
         blocks.push(scan.block);
         stats.push(scan.stats);
     }
-    attach_pair_geometry(&mut blocks, config)?;
+    match geometry {
+        Some(shared) => {
+            for (b, g) in blocks.iter_mut().zip(shared) {
+                b.pair_geometry = Some(Cow::Borrowed(g));
+            }
+        }
+        None => attach_pair_geometry(&mut blocks, config)?,
+    }
     let n_points: usize = blocks.iter().map(Block::len).sum();
     // Large enough to polish the best start on a subsample first.
     let polish = n_points > 2 * POLISH_SAMPLES;
     // Three independent order statistics over every sample (the floor, the
     // starting values, the subsamples' brightness threshold), side by side.
     let n_blocks = blocks.len().max(1);
+    // Every incidence of an all-incidence fit keeps a few samples in the
+    // starts' subsample, else its cost says little about the whole.
+    let start_samples = START_SAMPLES.max(START_SAMPLES_PER_INCIDENCE * n_blocks);
     let share = move |count: usize| count / n_blocks;
     let ((floor, starts), bright) = rayon::join(
         || {
@@ -125,7 +188,7 @@ fn fit_many(
     };
     let mut ends: Vec<DVector<f64>> = vec![starts[0].1.clone()];
     if starts.len() > 1 {
-        let sub = thin(START_SAMPLES);
+        let sub = thin(start_samples);
         // The starts are independent: run them in parallel; the order of
         // the candidates (lowest cost first, the first on ties) keeps the
         // choice deterministic.
@@ -173,7 +236,7 @@ fn fit_many(
         );
     }
     let u_start = ends.swap_remove(0);
-    let mut solved = solver.solve(&blocks, u_start, Stage::FINAL);
+    let mut solved = solver.solve_final(&blocks, u_start);
     evaluations += solved.evaluations;
     if !solved.cost.is_finite() {
         return Err(FitError::Failed {
@@ -251,7 +314,18 @@ fn attach_pair_geometry(blocks: &mut [Block<'_>], config: &FitConfig) -> Result<
     if pairs == 0 || pairs > GEOMETRY_CACHE_PAIRS {
         return Ok(());
     }
-    // The geometry does not depend on the arguments: any valid set will do.
+    let bsdf = geometry_bsdf(config)?;
+    blocks.par_iter_mut().for_each(|b| {
+        if let Some(p) = &b.pairs {
+            b.pair_geometry = Some(Cow::Owned(PairGeometry::new(p, &bsdf)));
+        }
+    });
+    Ok(())
+}
+
+/// A BSDF of the fit's type, orientation and options, for pair geometry:
+/// the geometry does not depend on the arguments, so any valid set will do.
+fn geometry_bsdf(config: &FitConfig) -> Result<Bsdf, FitError> {
     let args = vec![0.5; config.kind.n_args()];
     let material = Material::new(
         config.kind,
@@ -262,13 +336,7 @@ fn attach_pair_geometry(blocks: &mut [Block<'_>], config: &FitConfig) -> Result<
         origin: "patch pairs".into(),
         reason: e.to_string(),
     })?;
-    let bsdf = Bsdf::new(&material, &config.options);
-    blocks.par_iter_mut().for_each(|b| {
-        if let Some(p) = &b.pairs {
-            b.pair_geometry = Some(Cow::Owned(PairGeometry::new(p, &bsdf)));
-        }
-    });
-    Ok(())
+    Ok(Bsdf::new(&material, &config.options))
 }
 
 /// Polishes each candidate on `polish` (when given; a candidate whose

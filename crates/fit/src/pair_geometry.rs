@@ -12,14 +12,17 @@
 use crate::data::PatchPairs;
 use brtf_model::{Bsdf, GeometryBatch};
 use std::ops::Range;
+use std::sync::Arc;
 
-/// Every pair's geometry, sample by sample (the offsets of the
-/// [`PatchPairs`] it was made from).
+/// Every pair's geometry, and each sample's pairs in it. The batch is
+/// shared: an incidence's per-incidence and all-incidence fits and their
+/// subsamples all read the same one, so selecting samples copies only
+/// their ranges.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct PairGeometry {
-    /// Sample i's pairs are `offsets[i]..offsets[i + 1]` of `geometry`.
-    offsets: Vec<usize>,
-    pub geometry: GeometryBatch,
+    /// Sample i's pairs are `ranges[i]` of `geometry`.
+    ranges: Vec<Range<usize>>,
+    pub geometry: Arc<GeometryBatch>,
 }
 
 impl PairGeometry {
@@ -31,28 +34,22 @@ impl PairGeometry {
             geometry.extend(pairs.of(i).map(|(l, v)| bsdf.geometry(l, v)));
         }
         PairGeometry {
-            offsets: pairs.offsets.clone(),
-            geometry,
+            ranges: pairs.offsets.windows(2).map(|w| w[0]..w[1]).collect(),
+            geometry: Arc::new(geometry),
         }
     }
 
     /// Sample `i`'s pairs in [`PairGeometry::geometry`].
     #[inline]
     pub(crate) fn range(&self, i: usize) -> Range<usize> {
-        self.offsets[i]..self.offsets[i + 1]
+        self.ranges[i].clone()
     }
 
     /// The geometry of the samples `indices`, in that order.
     pub(crate) fn select(&self, indices: impl IntoIterator<Item = usize>) -> PairGeometry {
-        let mut out = PairGeometry {
-            offsets: vec![0],
-            geometry: GeometryBatch::new(),
-        };
-        for i in indices {
-            out.geometry
-                .extend(self.range(i).map(|k| self.geometry.get(k)));
-            out.offsets.push(out.geometry.len());
+        PairGeometry {
+            ranges: indices.into_iter().map(|i| self.range(i)).collect(),
+            geometry: Arc::clone(&self.geometry),
         }
-        out
     }
 }

@@ -626,11 +626,11 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
     /// The compressed residuals. The pass's compressed Jacobian is kept
     /// with them: the short residuals depend on the point's Q, so LM must
     /// get the Jacobian of the same pass, and it asks for it at its last
-    /// accepted point, which it has always evaluated already.
+    /// accepted point, which it has always evaluated already. A point
+    /// already in the history (a seeded start) is not evaluated again.
     fn residuals(&self) -> Option<DVector<f64>> {
-        let c = self.compressed(&self.u)?;
+        let c = self.evaluated(&self.u)?;
         let residuals = c.residuals.clone();
-        self.history.borrow_mut().push((self.u.clone(), c));
         Some(residuals)
     }
 

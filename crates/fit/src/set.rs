@@ -5,7 +5,9 @@
 use crate::config::{FitConfig, FitError};
 use crate::data::IncidenceData;
 use crate::diagnose;
-use crate::fitter::{fit_global, fit_incidence};
+use crate::fitter::{
+    fit_global_sharing, fit_incidence, fit_incidence_sharing, shared_pair_geometry,
+};
 use crate::recipe::{PreparedMeasurement, Recipe, RecipeError, ScaleRule};
 use crate::report::FitReport;
 use crate::result::{FIT_JSON_SCHEMA, FitResult, InputFile, Provenance, SetWarning};
@@ -453,11 +455,15 @@ fn fit_all(
     progress: &dyn Progress,
 ) -> Result<(Vec<FitReport>, FitReport), FitSetError> {
     let data: Vec<IncidenceData> = inputs.iter().map(|i| i.prepared.incidence_data()).collect();
+    // Patch pairs' geometry is computed once for both fits of each incidence.
+    let geometry = shared_pair_geometry(&data, config)?;
+    let geometry = geometry.as_deref();
     let (reports, global) = rayon::join(
         || {
             data.par_iter()
-                .map(|d| {
-                    let r = fit_incidence(d, config);
+                .enumerate()
+                .map(|(i, d)| {
+                    let r = fit_incidence_sharing(d, config, geometry.map(|g| &g[i]));
                     progress.advance();
                     r
                 })
@@ -468,7 +474,7 @@ fn fit_all(
             if data.len() < 2 {
                 return None;
             }
-            let r = fit_global(&data, config);
+            let r = fit_global_sharing(&data, config, geometry);
             progress.advance();
             Some(r)
         },

@@ -6,7 +6,7 @@ use crate::params::ParamMap;
 use crate::problem::{Block, Compressed, Problem};
 use glam::DVec3;
 use levenberg_marquardt::{LevenbergMarquardt, TerminationReason};
-use nalgebra::DVector;
+use nalgebra::{DMatrix, DVector};
 
 /// Tolerances of one Levenberg-Marquardt run.
 #[derive(Clone, Copy)]
@@ -30,7 +30,7 @@ impl Stage {
     /// compared at the cost it reached. The best start is polished and fitted
     /// to every sample afterwards.
     pub(crate) const START: Stage = Stage {
-        tolerance: 1e-6,
+        tolerance: 1e-3,
         gtol: 1e-14,
         patience: 8,
         report: false,
@@ -81,7 +81,80 @@ impl Solver<'_> {
 
     /// Runs Levenberg-Marquardt from `u0` on `blocks`.
     pub(crate) fn solve(&self, blocks: &[Block<'_>], u0: DVector<f64>, stage: Stage) -> Solved {
+        self.solve_seeded(blocks, u0, stage, Vec::new()).0
+    }
+
+    /// The fit on every sample, in rounds of [`ROUND_PATIENCE`]: when a
+    /// round ends on its budget with its last steps in one direction,
+    /// each shorter than the one before by a steady ratio, the rest of
+    /// that geometric series is taken in one step (kept only if it lowers
+    /// the cost), and the next round starts there.
+    ///
+    /// Gauss-Newton converges only linearly where the model cannot fit the
+    /// data (a large residual): on a Klems fabric's all-incidence fit each
+    /// step covered ~30 % of the remaining distance, 24–36 passes over
+    /// ten million patch pairs. A fit that converges within one round
+    /// takes exactly the steps it took before.
+    pub(crate) fn solve_final(&self, blocks: &[Block<'_>], u0: DVector<f64>) -> Solved {
+        let stage = Stage::FINAL;
+        let budget = stage.patience * (self.map.len() + 1);
+        let round = Stage {
+            patience: ROUND_PATIENCE,
+            ..stage
+        };
+        let mut spent = 0;
+        let mut start = u0;
+        let mut seed = Vec::new();
+        loop {
+            let (mut solved, accepted) = self.solve_seeded(blocks, start, round, seed);
+            spent += solved.evaluations;
+            let out_of_round = matches!(solved.termination, TerminationReason::LostPatience);
+            let Some(at_solution) = solved.at_solution.clone().filter(|_| out_of_round) else {
+                solved.evaluations = spent;
+                return solved;
+            };
+            let jump = extrapolate(&accepted).and_then(|jump| {
+                let mut problem = self.problem(blocks);
+                problem.report = stage.report;
+                let c = problem.evaluated(&jump)?;
+                spent += problem.evaluations.get();
+                (0.5 * c.residuals.norm_squared() < solved.cost).then_some((jump, c))
+            });
+            match jump {
+                Some((u, c)) if spent < budget => {
+                    start = u.clone();
+                    seed = vec![(u, c)];
+                }
+                // Nothing to gain from another restart (LM would lose its
+                // damping again): finish with the rest of the budget.
+                _ => {
+                    let (u, c) = jump.unwrap_or((solved.u.clone(), at_solution));
+                    let rest = Stage {
+                        patience: budget
+                            .saturating_sub(spent)
+                            .div_ceil(self.map.len() + 1)
+                            .max(1),
+                        ..stage
+                    };
+                    let (mut last, _) = self.solve_seeded(blocks, u.clone(), rest, vec![(u, c)]);
+                    last.evaluations += spent;
+                    return last;
+                }
+            }
+        }
+    }
+
+    /// Runs Levenberg-Marquardt from `u0`, whose pass may be in `seed`;
+    /// also returns the accepted points (each lowering the cost) in order.
+    fn solve_seeded(
+        &self,
+        blocks: &[Block<'_>],
+        u0: DVector<f64>,
+        stage: Stage,
+        seed: Vec<(DVector<f64>, Compressed)>,
+    ) -> (Solved, Vec<DVector<f64>>) {
         let mut problem = self.problem(blocks);
+        *problem.history.borrow_mut() = seed;
         problem.u = u0.clone();
         problem.report = stage.report;
         let (problem, report) = LevenbergMarquardt::new()
@@ -98,7 +171,17 @@ impl Solver<'_> {
         );
         let u = if failed { u0 } else { problem.u.clone() };
         let at_solution = problem.evaluated(&u);
-        Solved {
+        let history = problem.history.take();
+        let mut accepted = Vec::new();
+        let mut lowest = f64::INFINITY;
+        for (at, c) in &history {
+            let cost = 0.5 * c.residuals.norm_squared();
+            if cost < lowest {
+                lowest = cost;
+                accepted.push(at.clone());
+            }
+        }
+        let solved = Solved {
             cost: at_solution
                 .as_ref()
                 .map_or(f64::INFINITY, |c| 0.5 * c.residuals.norm_squared()),
@@ -106,6 +189,76 @@ impl Solver<'_> {
             termination: report.termination,
             evaluations: problem.evaluations.get(),
             at_solution,
+        };
+        (solved, accepted)
+    }
+}
+
+/// Evaluation budget of one round of [`Solver::solve_final`], in units of
+/// (parameters + 1): a fit from a polished start converges within it.
+const ROUND_PATIENCE: usize = 1;
+/// Most steps the extrapolation looks back on.
+const LOOK_BACK: usize = 6;
+
+/// Reduced rank extrapolation over the last accepted points u₀ … u_p:
+/// where Gauss-Newton converges linearly, u_{k+1} − u* ≈ M (u_k − u*),
+/// and the combination Σ γᵢ uᵢ (Σ γᵢ = 1) whose steps Σ γᵢ (u_{i+1} − uᵢ)
+/// cancel best is the limit, exactly so when M has at most p − 1
+/// eigenvalues that matter.
+fn extrapolate(accepted: &[DVector<f64>]) -> Option<DVector<f64>> {
+    let points = &accepted[accepted.len().saturating_sub(LOOK_BACK + 1)..];
+    let p = points.len().checked_sub(1).filter(|&p| p >= 2)?;
+    let steps = DMatrix::from_fn(points[0].len(), p, |r, c| points[c + 1][r] - points[c][r]);
+    let mut gram = steps.transpose() * &steps;
+    // A tiny ridge keeps nearly parallel steps solvable.
+    let ridge = 1e-12 * gram.trace().max(f64::MIN_POSITIVE);
+    for k in 0..p {
+        gram[(k, k)] += ridge;
+    }
+    let weights = gram.cholesky()?.solve(&DVector::from_element(p, 1.0));
+    let total = weights.sum();
+    if !(total.is_finite() && total != 0.0) {
+        return None;
+    }
+    let limit = points[..p]
+        .iter()
+        .zip(weights.iter())
+        .fold(DVector::zeros(points[0].len()), |acc, (u, w)| {
+            acc + u * (w / total)
+        });
+    limit.iter().all(|v| v.is_finite()).then_some(limit)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A linear iteration u_{k+1} − u* = M (u_k − u*) with two modes
+    /// (ratios 0.7 and 0.4) and a third at rest: three steps determine u*.
+    fn linear_sequence(count: usize) -> (Vec<DVector<f64>>, DVector<f64>) {
+        let limit = DVector::from_vec(vec![1.0, -2.0, 0.5]);
+        let m = DMatrix::from_row_slice(3, 3, &[0.7, 0.1, 0.0, 0.0, 0.4, 0.0, 0.0, 0.0, 0.0]);
+        let mut u = DVector::from_vec(vec![3.0, 1.0, 0.5]);
+        let mut points = Vec::new();
+        for _ in 0..count {
+            points.push(u.clone());
+            u = &limit + &m * (&u - &limit);
         }
+        (points, limit)
+    }
+
+    #[test]
+    fn extrapolation_finds_the_limit_of_a_linear_iteration() {
+        let (points, limit) = linear_sequence(6);
+        let jump = extrapolate(&points).expect("an extrapolation");
+        assert!((&jump - &limit).norm() < 1e-9, "{jump} vs {limit}");
+        // The last point is still far from it: the jump is worth taking.
+        assert!((points.last().unwrap() - &limit).norm() > 1e-2);
+    }
+
+    #[test]
+    fn extrapolation_needs_three_points() {
+        let (points, _) = linear_sequence(2);
+        assert!(extrapolate(&points).is_none());
     }
 }
