@@ -135,8 +135,18 @@ fn result_of(
     global: Option<FitReport>,
     method: Interpolation,
 ) -> FitResult {
+    // Rings of azimuths share a θ_in: their rows are averaged over φ_in.
     let table = (incidences.len() > 1).then(|| {
-        ParamTable::from_reports(config.kind, config.orientation, &incidences, method).unwrap()
+        ParamTable::from_reports(config.kind, config.orientation, &incidences, method)
+            .or_else(|_| {
+                ParamTable::from_reports_phi_averaged(
+                    config.kind,
+                    config.orientation,
+                    &incidences,
+                    method,
+                )
+            })
+            .unwrap()
     });
     FitResult {
         schema: brtf_fit::FIT_JSON_SCHEMA,
@@ -778,6 +788,134 @@ fn theta_export_matches_live_rtrace() {
         eprintln!("  {name:>16}: {n} values, worst relative {worst:.2e}");
     }
     stats.assert_ok("theta_export_matches_live_rtrace", rel, abs);
+}
+
+/// A `trans2` fitted to rings of azimuths (as to a Klems basis) follows
+/// (θ_in, φ_in): rtrace on its `-theta.rad` equals brtf-model with
+/// `ParamTable::at_direction(θ_in, φ_in)`, at the fitted incidences and
+/// between them in θ_in and φ_in, for both interpolation methods. The
+/// orientation is turned, so φ_in counts from u, not from x.
+#[test]
+fn azimuth_export_matches_live_rtrace() {
+    let Some(radiance) = live::radiance_or_skip("azimuth_export_matches_live_rtrace") else {
+        return;
+    };
+    let tmp = temp_dir();
+    let scene_dir = tmp.path().join("scene");
+    std::fs::create_dir_all(&scene_dir).unwrap();
+    // u at 30° from x: φ_in from u is the light's azimuth minus 30°.
+    let orientation = [30f64.to_radians().cos(), 30f64.to_radians().sin(), 0.0];
+    let rings: [(f64, usize); 5] = [(0.0, 1), (15.0, 8), (30.0, 12), (45.0, 12), (60.0, 8)];
+    let args_at = |theta: f64, phi_from_u: f64| -> Vec<f64> {
+        let (c, s2) = (
+            phi_from_u.to_radians().cos(),
+            (2.0 * phi_from_u).to_radians().sin(),
+        );
+        let x = theta / 60.0;
+        let g = 0.30 + 0.05 * x;
+        vec![
+            g,
+            g,
+            g,
+            0.02 + 0.01 * x * (1.0 + c),
+            0.06 + 0.03 * x * (1.0 + 0.5 * s2),
+            0.10 + 0.04 * x * (1.0 - c),
+            0.15 + 0.05 * x * c,
+            0.5 + 0.2 * x * s2,
+        ]
+    };
+    let mut reports = Vec::new();
+    for (theta, count) in rings {
+        for k in 0..count {
+            // Azimuths of the light in the data's frame (from x).
+            let phi = 360.0 * k as f64 / count as f64 + 5.0;
+            let mut r = report(MaterialKind::Trans2, theta, &args_at(theta, phi - 30.0));
+            r.phi_in = phi;
+            reports.push(r);
+        }
+    }
+    let mut cases = Vec::new();
+    for (name, method) in [
+        ("aniso-pchip", Interpolation::Pchip),
+        ("aniso-linear", Interpolation::Linear),
+    ] {
+        let mut config = FitConfig::new(MaterialKind::Trans2);
+        config.orientation = orientation;
+        let mut result = result_of(name, config, reports.clone(), None, method);
+        result.table = Some(
+            ParamTable::from_reports_over_azimuth(
+                MaterialKind::Trans2,
+                orientation,
+                &reports,
+                method,
+                false,
+            )
+            .unwrap(),
+        );
+        let (dir, reread) = write_fit(tmp.path(), name, &result);
+        assert!(reread.table.as_ref().unwrap().depends_on_azimuth());
+        export(&dir, &["--out", s(&scene_dir), "--name", name]);
+        cases.push((name.to_string(), reread));
+    }
+    let files: Vec<String> = cases
+        .iter()
+        .map(|(n, _)| format!("{n}-theta.rad"))
+        .collect();
+    let names: Vec<String> = cases.iter().map(|(n, _)| n.clone()).collect();
+    let omega = cone_solid_angle(live::SOURCE_APEX_DEG);
+    // Light azimuths from x: on a ring's incidences, between them, across
+    // 0°/360°; θ_in on rows and between them.
+    let incidences = [
+        (15.0, 50.0),
+        (15.0, 72.5),
+        (22.0, 3.0),
+        (30.0, 350.0),
+        (37.5, 200.0),
+        (45.0, 125.0),
+        (52.0, 275.0),
+        (60.0, 95.0),
+        (7.0, 140.0),
+    ];
+    let (rel, abs) = (1e-2, 2e-5);
+    let mut stats = Stats::default();
+    let mut differs_from_mean = 0;
+    trace_all(
+        &radiance,
+        &scene_dir,
+        &files,
+        &names,
+        &incidences,
+        omega,
+        |k, t, p, v, f| {
+            let table = cases[k].1.table.as_ref().unwrap();
+            let options = EvalOptions {
+                variant: Variant::Radiance,
+                fresnel_k: cases[k].1.config.options.fresnel_k,
+                source_omega: omega,
+                flat: true,
+                source_jitter: 0.0,
+            };
+            let l = direction(t, p);
+            let material = table.at_direction(t, p - 30.0).unwrap().material;
+            let model = Bsdf::new(&material, &options).eval(l, v);
+            let mean = Bsdf::new(&table.at(t).unwrap().material, &options).eval(l, v);
+            if (mean[0] - model[0]).abs() > 0.05 * model[0].abs() {
+                differs_from_mean += 1;
+            }
+            stats.compare(model, f, rel, abs, &|| {
+                format!(
+                    "{} θ_in {t} φ_in {p} v ({:.4} {:.4} {:.4})",
+                    names[k], v.x, v.y, v.z
+                )
+            });
+        },
+    );
+    stats.assert_ok("azimuth_export_matches_live_rtrace", rel, abs);
+    // The azimuth matters: many values differ from the φ_in-averaged table's.
+    assert!(
+        differs_from_mean > 50,
+        "{differs_from_mean} values depend on φ_in"
+    );
 }
 
 #[test]

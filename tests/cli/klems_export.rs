@@ -532,3 +532,98 @@ fn two_sided_fit_folder_exports_four_components() {
         Some("grey")
     );
 }
+
+/// `trans2` fitted to the anisotropic Mecho fabric follows (θ_in, φ_in):
+/// its table keeps each θ ring over φ_in, and the Klems file exported
+/// from it (each incident patch with the parameters at its own azimuth)
+/// is closer to the measured matrices than the same fit's φ_in-averaged
+/// table gives, in both directions of the front side.
+#[test]
+fn anisotropic_fit_exports_the_parameters_of_each_azimuth() {
+    let tmp = temp_dir();
+    let fabric =
+        crate::common::repo_path("../shared/data/lbnl-frads-klems-fabrics/klems_aniso_high.xml");
+    let fit_dir = tmp.path().join("mecho");
+    brtf(
+        &[
+            "fit",
+            s(&fabric),
+            "--model",
+            "trans2",
+            "--gray",
+            "--side",
+            "front",
+            "--incidences",
+            "theta<=40",
+            "--no-plots",
+            "--no-export",
+            "--no-adequacy",
+            "--out",
+            s(&fit_dir),
+        ],
+        "",
+    )
+    .ok();
+    let json = std::fs::read_to_string(fit_dir.join("fit.json")).unwrap();
+    let value: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let rings = value["table"]["azimuth"].as_array().expect("azimuth rings");
+    let counts: Vec<usize> = rings
+        .iter()
+        .map(|r| r["phi_in"].as_array().unwrap().len())
+        .collect();
+    assert_eq!(counts, [1, 8, 16, 20, 24], "the Klems rings to 40°");
+    // The same fit without the rings: φ_in-averaged rows only.
+    let averaged_dir = tmp.path().join("averaged");
+    std::fs::create_dir_all(&averaged_dir).unwrap();
+    let mut averaged = value.clone();
+    averaged["table"].as_object_mut().unwrap().remove("azimuth");
+    write_file(
+        &averaged_dir,
+        "fit.json",
+        &serde_json::to_string_pretty(&averaged).unwrap(),
+    );
+    let measured = klems::read_path(&fabric).unwrap();
+    let band = &measured.bands()[0];
+    let mut errors = Vec::new();
+    for dir in [&fit_dir, &averaged_dir] {
+        brtf(&["export", s(dir), "--klems", "--name", "shade"], "").ok();
+        let exported = klems::read_path(&dir.join("shade.xml")).unwrap();
+        let mut per_direction = Vec::new();
+        for direction in [
+            KlemsDirection::TransmissionBack,
+            KlemsDirection::ReflectionBack,
+        ] {
+            let a = measured.matrix(band, direction).unwrap();
+            let b = exported.matrix(&exported.bands()[0], direction).unwrap();
+            let n = measured.basis.len();
+            // Incident patches of the fitted rings (θ ≤ 40°: the first 69).
+            let (mut diff, mut norm) = (0.0, 0.0);
+            for i in 0..69 {
+                for o in 0..n {
+                    diff += (a.value(o, i) - b.value(o, i)).powi(2);
+                    norm += a.value(o, i).powi(2);
+                }
+            }
+            per_direction.push((diff / norm).sqrt());
+        }
+        errors.push(per_direction);
+    }
+    eprintln!(
+        "relative rms error (transmission, reflection): with azimuths {:.4?}, averaged {:.4?}",
+        errors[0], errors[1]
+    );
+    // Transmission carries the fabric's anisotropy; its reflection is
+    // mostly diffuse, so it gains little, but must not lose.
+    assert!(
+        errors[0][0] < 0.9 * errors[1][0],
+        "transmission: with azimuths {:.4}, averaged {:.4}",
+        errors[0][0],
+        errors[1][0]
+    );
+    assert!(
+        errors[0][1] <= errors[1][1],
+        "reflection: with azimuths {:.4}, averaged {:.4}",
+        errors[0][1],
+        errors[1][1]
+    );
+}

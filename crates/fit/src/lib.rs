@@ -88,4 +88,4 @@ pub use set::{
     fit_set_with_data, prepare_input,
 };
 pub use summary::summary;
-pub use table::{Interpolation, ParamTable, TableError, TableLookup};
+pub use table::{AzimuthRing, Interpolation, ParamTable, TableError, TableLookup, azimuth_from_u};

@@ -307,6 +307,15 @@ impl FitResult {
             .or_else(|| self.provenance.inputs.get(index))
     }
 
+    /// True when the fitted data are the back side of a Klems file, whose
+    /// frame is mirrored ([`crate::azimuth_from_u`]).
+    pub fn is_mirrored_side(&self) -> bool {
+        self.provenance.inputs.iter().any(|i| {
+            i.klems
+                .is_some_and(|k| k.side == brtf_gonio::klems::Side::Back)
+        })
+    }
+
     /// The material at θ_in: the table's, else the incidence's own fit
     /// (`report`), else the static material.
     pub fn material_at(&self, theta_in: f64, report: Option<&FitReport>) -> Option<Material> {

@@ -233,18 +233,23 @@ pub fn fit_set_with_data(
     }
 
     // Klems incidences come in θ rings of azimuth patches: the table
-    // averages each ring over φ_in.
-    let build = if recipe.patch_average.is_some() {
-        ParamTable::from_reports_phi_averaged
+    // averages each ring over φ_in, and an anisotropic type's also keeps
+    // each ring over φ_in.
+    let (kind, orientation, method) = (config.kind, config.orientation, options.interpolation);
+    let built = if recipe.patch_average.is_none() {
+        ParamTable::from_reports(kind, orientation, &reports, method)
+    } else if kind.is_anisotropic() {
+        // The back side's frame is mirrored.
+        let mirrored = inputs.iter().any(|i| {
+            i.file
+                .klems
+                .is_some_and(|k| k.side == brtf_gonio::klems::Side::Back)
+        });
+        ParamTable::from_reports_over_azimuth(kind, orientation, &reports, method, mirrored)
     } else {
-        ParamTable::from_reports
+        ParamTable::from_reports_phi_averaged(kind, orientation, &reports, method)
     };
-    let table = match build(
-        config.kind,
-        config.orientation,
-        &reports,
-        options.interpolation,
-    ) {
+    let table = match built {
         Ok(t) => Some(t),
         Err(e) => {
             warnings.push(SetWarning::NoTable {

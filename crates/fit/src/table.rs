@@ -1,6 +1,13 @@
 //! Per-incidence parameters as a function of θ_in: a monotone cubic
 //! (PCHIP, Fritsch–Carlson) or linear interpolation, clamped outside the
 //! measured range.
+//!
+//! An anisotropic type fitted to rings of incidences at several azimuths
+//! (a Klems basis) also keeps each ring's incidences over φ_in
+//! ([`AzimuthRing`]). Its parameters at (θ_in, φ_in) are each ring's
+//! values at φ_in (linear between the ring's azimuths, periodic), then
+//! interpolated over θ_in by the table's method, as the φ-averaged rows
+//! are.
 
 use crate::report::FitReport;
 use brtf_model::{Material, MaterialKind, ModelError};
@@ -48,8 +55,55 @@ pub struct ParamTable {
     pub method: Interpolation,
     /// θ_in of each row, ascending, in degrees.
     pub theta_in: Vec<f64>,
-    /// `args[row]`: the material's real arguments at that θ_in.
+    /// `args[row]`: the material's real arguments at that θ_in (averaged
+    /// over the row's azimuths when it has several).
     pub args: Vec<Vec<f64>>,
+    /// For an anisotropic type fitted to rings of azimuths: each row's
+    /// incidences over φ_in, so the parameters follow (θ_in, φ_in).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub azimuth: Option<Vec<AzimuthRing>>,
+}
+
+/// The azimuth of a table's rings ([`AzimuthRing::phi_in`]) for a light
+/// at azimuth `phi_data` (degrees) in the data's frame: counted from u,
+/// the orientation's azimuth in that frame, and negated when the data's
+/// frame is mirrored (the back side of a Klems file keeps x and y and
+/// flips z; its right-handed frame, the side seen as a front, has −y).
+pub fn azimuth_from_u(orientation: [f64; 3], mirrored: bool, phi_data: f64) -> f64 {
+    let phi = phi_data - orientation[1].atan2(orientation[0]).to_degrees();
+    (if mirrored { -phi } else { phi }).rem_euclid(360.0)
+}
+
+/// The incidences of one θ_in row at their azimuths.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AzimuthRing {
+    /// φ_in of each incidence in degrees, ascending in [0, 360): the
+    /// light's azimuth from u (the orientation vector projected on the
+    /// surface) towards v = n × u, with n the normal on the light's side.
+    pub phi_in: Vec<f64>,
+    /// `args[k]`: the material's real arguments at `phi_in[k]`.
+    pub args: Vec<Vec<f64>>,
+}
+
+impl AzimuthRing {
+    /// Argument `j` at azimuth `phi` (degrees): linear between the ring's
+    /// azimuths, across 360° → 0° too; one azimuth holds everywhere.
+    pub fn arg_at(&self, j: usize, phi: f64) -> f64 {
+        let n = self.phi_in.len();
+        if n == 1 {
+            return self.args[0][j];
+        }
+        let phi = phi.rem_euclid(360.0);
+        // Between the last azimuth at or below φ and the next one, a turn
+        // later past the last; below the first, from the last a turn back.
+        let (k, from, next, to) = match self.phi_in.iter().rposition(|&p| p <= phi) {
+            Some(k) if k + 1 < n => (k, self.phi_in[k], k + 1, self.phi_in[k + 1]),
+            Some(k) => (k, self.phi_in[k], 0, self.phi_in[0] + 360.0),
+            None => (n - 1, self.phi_in[n - 1] - 360.0, 0, self.phi_in[0]),
+        };
+        let t = (phi - from) / (to - from);
+        self.args[k][j] + t * (self.args[next][j] - self.args[k][j])
+    }
 }
 
 /// A material at some θ_in, and whether θ_in was outside the table.
@@ -86,6 +140,7 @@ impl ParamTable {
             method,
             theta_in: rows.iter().map(|r| r.0).collect(),
             args: rows.into_iter().map(|r| r.1).collect(),
+            azimuth: None,
         })
     }
 
@@ -125,7 +180,45 @@ impl ParamTable {
                 .into_iter()
                 .map(|(_, sum, count)| sum.into_iter().map(|s| s / count as f64).collect())
                 .collect(),
+            azimuth: None,
         })
+    }
+
+    /// [`Self::from_reports_phi_averaged`], keeping each row's incidences
+    /// over φ_in too, for an anisotropic type. Each report's φ_in becomes
+    /// [`azimuth_from_u`]'s: counted from u, and negated for data described
+    /// in a mirrored frame (`mirrored`: the back side of a Klems file).
+    pub fn from_reports_over_azimuth(
+        kind: MaterialKind,
+        orientation: [f64; 3],
+        reports: &[FitReport],
+        method: Interpolation,
+        mirrored: bool,
+    ) -> Result<ParamTable, TableError> {
+        let mut table = Self::from_reports_phi_averaged(kind, orientation, reports, method)?;
+        let mut rings: Vec<Vec<(f64, Vec<f64>)>> = vec![Vec::new(); table.theta_in.len()];
+        for r in reports {
+            let row = table
+                .theta_in
+                .iter()
+                .position(|t| (r.theta_in - t).abs() < 1e-9)
+                .expect("every report's θ_in is a row");
+            let phi = azimuth_from_u(orientation, mirrored, r.phi_in);
+            rings[row].push((phi, r.material_args.clone()));
+        }
+        let mut azimuth = Vec::with_capacity(rings.len());
+        for (mut ring, theta) in rings.into_iter().zip(&table.theta_in) {
+            ring.sort_by(|a, b| a.0.total_cmp(&b.0));
+            if ring.windows(2).any(|w| w[1].0 - w[0].0 < 1e-9) {
+                return Err(TableError::Invalid(format!(
+                    "two incidences share θ_in = {theta}° and φ_in"
+                )));
+            }
+            let (phi_in, args) = ring.into_iter().unzip();
+            azimuth.push(AzimuthRing { phi_in, args });
+        }
+        table.azimuth = Some(azimuth);
+        Ok(table)
     }
 
     /// Measured θ_in range.
@@ -170,18 +263,82 @@ impl ParamTable {
             }
             Material::new(self.kind, row, Some(DVec3::from_array(self.orientation)))?;
         }
+        if let Some(rings) = &self.azimuth {
+            if rings.len() != self.theta_in.len() {
+                return invalid(format!(
+                    "{} azimuth rings for {} θ_in values",
+                    rings.len(),
+                    self.theta_in.len()
+                ));
+            }
+            for (ring, t) in rings.iter().zip(&self.theta_in) {
+                if ring.phi_in.is_empty() || ring.phi_in.len() != ring.args.len() {
+                    return invalid(format!(
+                        "the ring at {t}° has {} azimuths and {} rows of arguments",
+                        ring.phi_in.len(),
+                        ring.args.len()
+                    ));
+                }
+                if ring.phi_in.iter().any(|p| !(0.0..360.0).contains(p))
+                    || ring.phi_in.windows(2).any(|w| w[1] <= w[0])
+                {
+                    return invalid(format!(
+                        "the ring at {t}°: φ_in is not ascending in [0, 360)"
+                    ));
+                }
+                for row in &ring.args {
+                    if row.len() != n {
+                        return invalid(format!(
+                            "the ring at {t}° has a row of {} arguments, a {} has {n}",
+                            row.len(),
+                            self.kind
+                        ));
+                    }
+                    Material::new(self.kind, row, Some(DVec3::from_array(self.orientation)))?;
+                }
+            }
+        }
         Ok(())
     }
 
-    /// Interpolated real arguments at `theta_in` (clamped to the range).
+    /// Interpolated real arguments at `theta_in` (clamped to the range),
+    /// from the rows (averaged over φ_in where a row has several).
     pub fn args_at(&self, theta_in: f64) -> (Vec<f64>, bool) {
+        self.interpolate(theta_in, |row, j| self.args[row][j])
+    }
+
+    /// True when the parameters follow φ_in too ([`Self::azimuth`]).
+    pub fn depends_on_azimuth(&self) -> bool {
+        self.azimuth.is_some()
+    }
+
+    /// Interpolated real arguments for a light at (`theta_in`, `phi_in`)
+    /// (degrees; φ_in as in [`AzimuthRing::phi_in`]): each row's value at
+    /// φ_in, interpolated over θ_in. Without azimuth rings, [`Self::args_at`].
+    pub fn args_at_direction(&self, theta_in: f64, phi_in: f64) -> (Vec<f64>, bool) {
+        match &self.azimuth {
+            None => self.args_at(theta_in),
+            Some(rings) => self.interpolate(theta_in, |row, j| rings[row].arg_at(j, phi_in)),
+        }
+    }
+
+    /// The material for a light at (`theta_in`, `phi_in`).
+    pub fn at_direction(&self, theta_in: f64, phi_in: f64) -> Result<TableLookup, TableError> {
+        let (args, clamped) = self.args_at_direction(theta_in, phi_in);
+        let material = Material::new(self.kind, &args, Some(DVec3::from_array(self.orientation)))?;
+        Ok(TableLookup { material, clamped })
+    }
+
+    /// Each argument interpolated over θ_in through the rows' values
+    /// `value(row, argument)`.
+    fn interpolate(&self, theta_in: f64, value: impl Fn(usize, usize) -> f64) -> (Vec<f64>, bool) {
         let (lo, hi) = self.range();
         let clamped = theta_in < lo || theta_in > hi;
         let t = theta_in.clamp(lo, hi);
         let n_args = self.args[0].len();
         let args = (0..n_args)
             .map(|j| {
-                let ys: Vec<f64> = self.args.iter().map(|row| row[j]).collect();
+                let ys: Vec<f64> = (0..self.theta_in.len()).map(|row| value(row, j)).collect();
                 match self.method {
                     Interpolation::Linear => linear(&self.theta_in, &ys, t),
                     Interpolation::Pchip => pchip(&self.theta_in, &ys, t),
@@ -276,6 +433,37 @@ mod tests {
             );
             last = v;
         }
+    }
+
+    fn ring(phi_in: &[f64], values: &[f64]) -> AzimuthRing {
+        AzimuthRing {
+            phi_in: phi_in.to_vec(),
+            args: values.iter().map(|v| vec![*v]).collect(),
+        }
+    }
+
+    #[test]
+    fn a_ring_is_linear_between_azimuths_and_wraps_around() {
+        let r = ring(&[0.0, 90.0, 180.0, 270.0], &[1.0, 2.0, 3.0, 4.0]);
+        for (phi, want) in [
+            (0.0, 1.0),
+            (45.0, 1.5),
+            (270.0, 4.0),
+            (315.0, 2.5),
+            (360.0, 1.0),
+            (-45.0, 2.5),
+        ] {
+            assert!(
+                (r.arg_at(0, phi) - want).abs() < 1e-12,
+                "{phi}: {}",
+                r.arg_at(0, phi)
+            );
+        }
+        // Azimuths that do not start at 0 wrap below the first one.
+        let r = ring(&[22.5, 202.5], &[0.0, 1.0]);
+        assert!((r.arg_at(0, 0.0) - 0.125).abs() < 1e-12);
+        assert!((r.arg_at(0, 350.0) - (1.0 - 147.5 / 180.0)).abs() < 1e-12);
+        assert_eq!(ring(&[180.0], &[7.0]).arg_at(0, 3.0), 7.0);
     }
 
     #[test]

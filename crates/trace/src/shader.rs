@@ -6,7 +6,12 @@
 //! parameters at the **light's** polar angle θ_l = acos|l·n| (the
 //! incidence of the measurement it was fitted to): the table is sampled
 //! on a 0.25° grid once, and `f` is interpolated linearly between the two
-//! neighbouring grid materials.
+//! neighbouring grid materials. A table that follows φ_in too (an
+//! anisotropic type fitted to a Klems basis) is sampled on a 1° × 2.5°
+//! (θ, φ) grid and interpolated bilinearly, with φ_l the light's azimuth
+//! from u towards v = n × u, n the normal on the light's side
+//! ([`brtf_fit::AzimuthRing`]). Where the orientation is along the normal
+//! (no azimuth), the φ-averaged rows apply.
 //!
 //! The shader always evaluates the **point** BSDF (brtf-model with source
 //! solid angle ω = 0): the tracer integrates over a source's solid angle
@@ -29,6 +34,9 @@ use crate::sampling::{ReflectionLobe, TransmissionLobe};
 
 /// Grid step (degrees) of a θ_in-table shader.
 pub const TABLE_STEP_DEG: f64 = 0.25;
+
+/// Grid steps (degrees) in θ_in and φ_in of a table that follows φ_in.
+pub const AZIMUTH_GRID_STEP_DEG: (f64, f64) = (1.0, 2.5);
 
 /// rtrace clamps the view cosine (`pdot >= .001`).
 const MIN_VIEW_COSINE: f64 = 0.001;
@@ -158,6 +166,60 @@ pub struct Shader {
     options: EvalOptions,
     /// Some entry has roughness 0 (mirror and straight-through deltas).
     has_delta: bool,
+    /// A table that follows φ_in: its (θ, φ) grid.
+    azimuth: Option<AzimuthGrid>,
+}
+
+/// The materials of a (θ_in, φ_in) table on a regular grid.
+#[derive(Debug, Clone)]
+struct AzimuthGrid {
+    /// Row-major: θ rows of `columns` azimuths.
+    entries: Vec<Entry>,
+    columns: usize,
+}
+
+impl AzimuthGrid {
+    /// The four neighbouring grid materials of a light `l` (local frame)
+    /// and their bilinear weights.
+    #[inline]
+    fn blend(&self, l: DVec3) -> [(usize, f64); 4] {
+        let (theta_step, phi_step) = AZIMUTH_GRID_STEP_DEG;
+        let rows = self.entries.len() / self.columns;
+        let theta = l.z.abs().min(1.0).acos().to_degrees();
+        let x = (theta / theta_step).min((rows - 1) as f64);
+        let i = (x.floor() as usize).min(rows - 2);
+        let t = x - i as f64;
+        // Azimuth in the frame whose normal is on the light's side.
+        let phi = (l.z.signum() * l.y)
+            .atan2(l.x)
+            .to_degrees()
+            .rem_euclid(360.0);
+        let y = phi / phi_step;
+        let c = (y.floor() as usize) % self.columns;
+        let s = y - y.floor();
+        let d = (c + 1) % self.columns;
+        let at = |row: usize, col: usize| row * self.columns + col;
+        [
+            (at(i, c), (1.0 - t) * (1.0 - s)),
+            (at(i, d), (1.0 - t) * s),
+            (at(i + 1, c), t * (1.0 - s)),
+            (at(i + 1, d), t * s),
+        ]
+    }
+
+    #[inline]
+    fn mix(&self, l: DVec3, value: impl Fn(&Entry) -> Rgb) -> Rgb {
+        let mut sum = [0.0; 3];
+        for (e, w) in self.blend(l) {
+            if w != 0.0 {
+                let f = value(&self.entries[e]);
+                for k in 0..3 {
+                    sum[k] += w * f[k];
+                }
+            }
+        }
+        sum
+    }
 }
 
 impl Shader {
@@ -173,6 +235,7 @@ impl Shader {
             orientation: material.orientation(),
             anisotropic: material.kind().is_anisotropic(),
             options,
+            azimuth: None,
         }
     }
 
@@ -186,13 +249,33 @@ impl Shader {
                 Ok(Entry::new(&lookup.material, &options))
             })
             .collect::<Result<Vec<_>, TableError>>()?;
+        let azimuth = if table.depends_on_azimuth() {
+            let (theta_step, phi_step) = AZIMUTH_GRID_STEP_DEG;
+            let rows = (90.0 / theta_step).round() as usize + 1;
+            let columns = (360.0 / phi_step).round() as usize;
+            let entries = (0..rows * columns)
+                .map(|k| {
+                    let theta = (k / columns) as f64 * theta_step;
+                    let phi = (k % columns) as f64 * phi_step;
+                    let lookup = table.at_direction(theta, phi)?;
+                    Ok(Entry::new(&lookup.material, &options))
+                })
+                .collect::<Result<Vec<_>, TableError>>()?;
+            Some(AzimuthGrid { entries, columns })
+        } else {
+            None
+        };
         Ok(Shader {
-            has_delta: entries.iter().any(|e| e.bsdf.is_pure()),
+            has_delta: entries.iter().any(|e| e.bsdf.is_pure())
+                || azimuth
+                    .as_ref()
+                    .is_some_and(|g| g.entries.iter().any(|e| e.bsdf.is_pure())),
             entries,
             step: Some(TABLE_STEP_DEG),
             orientation: DVec3::from_array(table.orientation),
             anisotropic: table.kind.is_anisotropic(),
             options,
+            azimuth,
         })
     }
 
@@ -256,6 +339,9 @@ impl Shader {
     /// The whole BSDF `f(l, v)` (1/sr, no cosine), local frame.
     #[inline]
     pub fn eval(&self, l: DVec3, v: DVec3, degenerate: bool) -> Rgb {
+        if let (Some(grid), false) = (&self.azimuth, degenerate) {
+            return grid.mix(l, |e| e.bsdf(false).eval(l, v));
+        }
         let (i, j, t) = self.blend(l.z);
         let a = self.entries[i].bsdf(degenerate).eval(l, v);
         if t == 0.0 {
@@ -268,6 +354,9 @@ impl Shader {
     /// The diffuse part `f_d(l, v)` of [`Self::eval`] (`v.z ≥ 0`).
     #[inline]
     pub fn diffuse(&self, l: DVec3, v: DVec3) -> Rgb {
+        if let Some(grid) = &self.azimuth {
+            return grid.mix(l, |e| e.diffuse(l, v));
+        }
         let (i, j, t) = self.blend(l.z);
         let a = self.entries[i].diffuse(l, v);
         if t == 0.0 {

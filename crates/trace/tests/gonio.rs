@@ -230,6 +230,7 @@ fn renders_are_deterministic_and_thread_independent() {
 fn table_materials_render_with_the_parameters_of_the_incidence() {
     use brtf_fit::{Interpolation, ParamTable};
     let table = ParamTable {
+        azimuth: None,
         kind: MaterialKind::Metal,
         orientation: [1.0, 0.0, 0.0],
         method: Interpolation::Pchip,

@@ -131,6 +131,7 @@ fn shading_frames_reproduce_the_model_in_the_measurement_frame() {
 #[test]
 fn table_shader_uses_the_light_angle() {
     let table = ParamTable {
+        azimuth: None,
         kind: MaterialKind::Plastic,
         orientation: [1.0, 0.0, 0.0],
         method: Interpolation::Linear,
@@ -158,4 +159,83 @@ fn table_shader_uses_the_light_angle() {
             );
         }
     }
+}
+
+/// A table that follows φ_in (an anisotropic type fitted to rings of
+/// azimuths) is shaded with the parameters at the light's (θ_l, φ_l),
+/// φ_l counted from u in the frame whose normal is on the light's side:
+/// equal to brtf-model with `ParamTable::at_direction`, for reflection
+/// and transmission, and different from the φ_in-averaged rows.
+#[test]
+fn azimuth_table_shader_uses_the_light_azimuth() {
+    let rings: [(f64, usize); 4] = [(0.0, 1), (20.0, 8), (40.0, 12), (60.0, 8)];
+    let args_at = |theta: f64, phi: f64| -> Vec<f64> {
+        let (c, x) = (phi.to_radians().cos(), theta / 60.0);
+        vec![
+            0.3,
+            0.3,
+            0.3,
+            0.02 + 0.01 * x * (1.0 + c),
+            0.08 + 0.03 * x * (1.0 + c),
+            0.12,
+            0.2 + 0.1 * x * c,
+            0.5 + 0.2 * x * (2.0 * phi).to_radians().sin(),
+        ]
+    };
+    let mut table = ParamTable {
+        azimuth: None,
+        kind: MaterialKind::Trans2,
+        orientation: [1.0, 0.0, 0.0],
+        method: Interpolation::Pchip,
+        theta_in: Vec::new(),
+        args: Vec::new(),
+    };
+    let mut azimuth = Vec::new();
+    for (theta, count) in rings {
+        let phi_in: Vec<f64> = (0..count)
+            .map(|k| 360.0 * k as f64 / count as f64)
+            .collect();
+        let args: Vec<Vec<f64>> = phi_in.iter().map(|&p| args_at(theta, p)).collect();
+        let mean = (0..8)
+            .map(|j| args.iter().map(|a| a[j]).sum::<f64>() / count as f64)
+            .collect();
+        table.theta_in.push(theta);
+        table.args.push(mean);
+        azimuth.push(brtf_fit::AzimuthRing { phi_in, args });
+    }
+    table.azimuth = Some(azimuth);
+    table.validate().unwrap();
+    let options = EvalOptions::default();
+    let shader = Shader::from_table(&table, &options).unwrap();
+    let mut differs = 0;
+    for (theta, phi) in [(20.0, 45.0), (33.0, 100.0), (40.0, 357.0), (55.0, 210.0)] {
+        for light_below in [false, true] {
+            let mut l = brtf_model::direction(theta, phi);
+            if light_below {
+                // Through the surface: the same azimuth in the light's frame.
+                l = DVec3::new(l.x, -l.y, -l.z);
+            }
+            for v in [
+                brtf_model::direction(theta, phi + 180.0),
+                brtf_model::direction(30.0, 10.0),
+                brtf_model::direction(70.0, 250.0),
+            ] {
+                let material = table.at_direction(theta, phi).unwrap().material;
+                let want = Bsdf::new(&material, &options).eval(l, v);
+                let got = shader.eval(l, v, false);
+                let mean = Bsdf::new(&table.at(theta).unwrap().material, &options).eval(l, v);
+                for k in 0..3 {
+                    // Bilinear between grid materials 1° × 2.5° apart.
+                    assert!(
+                        (got[k] - want[k]).abs() <= 1e-2 * want[k] + 1e-6,
+                        "({theta}, {phi}) below {light_below}: {got:?} vs {want:?}"
+                    );
+                }
+                if (mean[0] - want[0]).abs() > 0.02 * want[0] {
+                    differs += 1;
+                }
+            }
+        }
+    }
+    assert!(differs >= 8, "only {differs} values depend on φ_l");
 }

@@ -29,6 +29,7 @@
 
 use super::num::num;
 use super::pieces::{FALLBACK_STEP, Pieces};
+use brtf_fit::{Interpolation, ParamTable};
 use brtf_model::{MaterialKind, Variant};
 use std::fmt::Write;
 
@@ -69,6 +70,9 @@ pub(crate) struct CalModel<'a> {
     pub orientation: [f64; 3],
     pub pieces: &'a Pieces,
     pub entry: Entry,
+    /// A table that follows φ_in too ([`ParamTable::azimuth`]): the
+    /// parameters become functions of (θ_in, φ_in).
+    pub azimuth: Option<&'a ParamTable>,
 }
 
 impl CalModel<'_> {
@@ -86,19 +90,170 @@ impl CalModel<'_> {
             }
         }
         o += "}\n\n";
-        self.parameters(&mut o);
+        let Some(table) = self.azimuth else {
+            self.parameters(&mut o, "p_");
+            self.constants(&mut o);
+            self.geometry(&mut o);
+            self.model(&mut o);
+            return o;
+        };
+        // The same model with every parameter a function of (t, f): the
+        // θ_in-only functions stay, as the mean over φ_in, for lights
+        // without an azimuth (orientation along the normal).
+        self.parameters(&mut o, "pm_");
+        self.azimuth_parameters(&mut o, table);
         self.constants(&mut o);
-        self.geometry(&mut o);
+        let mut rest = String::new();
+        self.geometry(&mut rest);
+        self.model(&mut rest);
+        o += &with_azimuth_argument(&rest);
+        o
+    }
+
+    /// Sections 4 to 7, after the parameters, constants and geometry.
+    fn model(&self, o: &mut String) {
         match self.entry {
-            Entry::Brtd { .. } => self.coefficients(&mut o),
+            Entry::Brtd { .. } => self.coefficients(o),
             Entry::Lobe => {}
         }
-        self.lobes(&mut o);
+        self.lobes(o);
         match self.entry {
-            Entry::Brtd { rd0, td0, deltas } => self.brtd_entry(&mut o, rd0, td0, deltas),
-            Entry::Lobe => self.lobe_entry(&mut o),
+            Entry::Brtd { rd0, td0, deltas } => self.brtd_entry(o, rd0, td0, deltas),
+            Entry::Lobe => self.lobe_entry(o),
         }
-        o
+    }
+
+    /// Section 1b: the parameters as functions of (θ_in, φ_in): each θ_in
+    /// row's value at φ_in (linear between its azimuths, periodic), then
+    /// brtf-fit's θ_in interpolation through those values, its slopes
+    /// worked out from them (Fritsch–Carlson for PCHIP), as
+    /// [`ParamTable::args_at_direction`] does.
+    fn azimuth_parameters(&self, o: &mut String, table: &ParamTable) {
+        let rings = table.azimuth.as_deref().expect("an azimuth table");
+        let thetas = &table.theta_in;
+        let n = thetas.len();
+        *o += "{ ===== 1b. The fitted parameters as functions of theta_in = t and phi_in = f\n";
+        *o += "  (degrees; phi_in from u towards v = N x u, N on the light's side). Each\n";
+        *o += "  theta_in row: linear in phi_in between its incidences' azimuths, periodic;\n";
+        let _ = writeln!(
+            o,
+            "  then {} over theta_in through the rows' values at phi_in. f < 0: no azimuth,\n  the phi_in-averaged pm_ functions. }}",
+            match table.method {
+                Interpolation::Pchip => "monotone cubic (PCHIP, Fritsch-Carlson slopes)",
+                Interpolation::Linear => "linear",
+            }
+        );
+        *o += "lin(x, x0, x1, y0, y1) : y0 + (x - x0)/(x1 - x0)*(y1 - y0);\n";
+        *o +=
+            "hermite(u, h, y0, y1, d0, d1) : (2*u*u*u - 3*u*u + 1)*y0 + (u*u*u - 2*u*u + u)*h*d0\n";
+        *o += "\t+ (-2*u*u*u + 3*u*u)*y1 + (u*u*u - u*u)*h*d1;\n";
+        *o += "harmonic(a, b, w1, w2) : if(a*b, (w1 + w2)/(w1/a + w2/b), 0);\n";
+        *o +=
+            "endslope(h0, h1, d0, d1) : endslope_s((( 2*h0 + h1)*d0 - h0*d1)/(h0 + h1), d0, d1);\n";
+        *o += "endslope_s(s, d0, d1) : if(s*d0, if(and(-(d0*d1) + 1e-300, abs(s) - 3*abs(d0)), 3*d0, s), 0);\n";
+        let names = self.kind.param_names();
+        for (p, name) in names.iter().enumerate() {
+            *o += "\n";
+            let same = |q: usize| rings.iter().all(|r| r.args.iter().all(|a| a[q] == a[p]));
+            if let Some(q) = (0..p.min(3)).find(|&q| p < 3 && same(q)) {
+                let _ = writeln!(o, "p_{name}(t, f) : p_{}(t, f);", names[q]);
+                continue;
+            }
+            let _ = writeln!(
+                o,
+                "p_{name}(t, f) : if(f + .5, pa_{name}(t_clamp(t), f), pm_{name}(t));"
+            );
+            // Each row's value at f.
+            for (r, ring) in rings.iter().enumerate() {
+                let phis = &ring.phi_in;
+                let values: Vec<f64> = ring.args.iter().map(|a| a[p]).collect();
+                let m = phis.len();
+                let body = if m == 1 {
+                    num(values[0])
+                } else {
+                    let wrap = |x: &str| {
+                        format!(
+                            "lin({x}, {}, {}, {}, {})",
+                            num(phis[m - 1] - 360.0),
+                            num(phis[0]),
+                            num(values[m - 1]),
+                            num(values[0])
+                        )
+                    };
+                    let mut chain = wrap("f - 360");
+                    for k in (0..m - 1).rev() {
+                        chain = format!(
+                            "if(f - {}, {chain}, lin(f, {}, {}, {}, {}))",
+                            num(phis[k + 1]),
+                            num(phis[k]),
+                            num(phis[k + 1]),
+                            num(values[k]),
+                            num(values[k + 1])
+                        );
+                    }
+                    format!("if({} - f, {}, {chain})", num(phis[0]), wrap("f"))
+                };
+                let _ = writeln!(o, "y_{name}_{r}(f) : {body};");
+            }
+            // Secants, slopes and the segments.
+            for i in 0..n - 1 {
+                let _ = writeln!(
+                    o,
+                    "s_{name}_{i}(f) : (y_{name}_{}(f) - y_{name}_{i}(f))/{};",
+                    i + 1,
+                    num(thetas[i + 1] - thetas[i])
+                );
+            }
+            let h = |i: usize| num(thetas[i + 1] - thetas[i]);
+            if table.method == Interpolation::Pchip {
+                for i in 0..n {
+                    let slope = if n == 2 {
+                        format!("s_{name}_0(f)")
+                    } else if i == 0 {
+                        format!("endslope({}, {}, s_{name}_0(f), s_{name}_1(f))", h(0), h(1))
+                    } else if i == n - 1 {
+                        format!(
+                            "endslope({}, {}, s_{name}_{}(f), s_{name}_{}(f))",
+                            h(n - 2),
+                            h(n - 3),
+                            n - 2,
+                            n - 3
+                        )
+                    } else {
+                        let (h0, h1) = (thetas[i] - thetas[i - 1], thetas[i + 1] - thetas[i]);
+                        format!(
+                            "harmonic(s_{name}_{}(f), s_{name}_{i}(f), {}, {})",
+                            i - 1,
+                            num(2.0 * h1 + h0),
+                            num(h1 + 2.0 * h0)
+                        )
+                    };
+                    let _ = writeln!(o, "d_{name}_{i}(f) : {slope};");
+                }
+            }
+            let segment = |i: usize| match table.method {
+                Interpolation::Pchip => format!(
+                    "hermite((t - {})/{}, {}, y_{name}_{i}(f), y_{name}_{}(f), d_{name}_{i}(f), d_{name}_{}(f))",
+                    num(thetas[i]),
+                    h(i),
+                    h(i),
+                    i + 1,
+                    i + 1
+                ),
+                Interpolation::Linear => format!(
+                    "lin(t, {}, {}, y_{name}_{i}(f), y_{name}_{}(f))",
+                    num(thetas[i]),
+                    num(thetas[i + 1]),
+                    i + 1
+                ),
+            };
+            let mut chain = segment(n - 2);
+            for i in (0..n - 2).rev() {
+                chain = format!("if(t - {}, {chain}, {})", num(thetas[i + 1]), segment(i));
+            }
+            let _ = writeln!(o, "pa_{name}(t, f) : {chain};");
+        }
+        *o += "\n";
     }
 
     fn iso(&self) -> bool {
@@ -109,8 +264,8 @@ impl CalModel<'_> {
         self.kind.is_transmitting()
     }
 
-    /// Section 1: the parameter functions `p_<name>(t)`.
-    fn parameters(&self, o: &mut String) {
+    /// Section 1: the parameter functions `<prefix><name>(t)`.
+    fn parameters(&self, o: &mut String, prefix: &str) {
         let nodes = &self.pieces.nodes;
         let (lo, hi) = (nodes[0], nodes[nodes.len() - 1]);
         let list: Vec<String> = nodes.iter().map(|&x| num(x)).collect();
@@ -140,10 +295,10 @@ impl CalModel<'_> {
             // A grey colour: green and blue repeat red.
             let same_colour = (0..p.min(3)).find(|&q| self.pieces.segments[q] == *segs);
             if let (true, Some(q)) = (p < 3, same_colour) {
-                let _ = writeln!(o, "p_{name}(t) : p_{}(t);", names[q]);
+                let _ = writeln!(o, "{prefix}{name}(t) : {prefix}{}(t);", names[q]);
                 continue;
             }
-            let _ = writeln!(o, "p_{name}(t) : p_{name}_0(t_clamp(t));");
+            let _ = writeln!(o, "{prefix}{name}(t) : {prefix}{name}_0(t_clamp(t));");
             let last = segs.len() - 1;
             for (i, seg) in segs.iter().enumerate() {
                 let c = seg.coef;
@@ -158,12 +313,12 @@ impl CalModel<'_> {
                 if i < last {
                     let _ = writeln!(
                         o,
-                        "p_{name}_{i}(t) : if(t - {}, p_{name}_{}(t), {cubic});",
+                        "{prefix}{name}_{i}(t) : if(t - {}, {prefix}{name}_{}(t), {cubic});",
                         num(nodes[i + 1]),
                         i + 1
                     );
                 } else {
-                    let _ = writeln!(o, "p_{name}_{i}(t) : {cubic};");
+                    let _ = writeln!(o, "{prefix}{name}_{i}(t) : {cubic};");
                 }
             }
         }
@@ -457,5 +612,30 @@ impl CalModel<'_> {
         } else {
             *o += "lobe_c(c, hx, hy, hz, om) = if(c, lobe(c, hx, hy, hz, om, thin(c)), 0);\n";
         }
+    }
+}
+
+/// Sections 3 to 7 of a (θ_in, φ_in) table: every function of θ_in `t`
+/// also takes φ_in `f`, and the entry points work φ_in out from the light
+/// as they work out θ_in. The generated text passes `t` always as the
+/// last argument, `(t)` or `, t)`, so that is what is rewritten.
+fn with_azimuth_argument(text: &str) -> String {
+    let text = text
+        .replace("(t)", "(t, f)")
+        .replace(", t)", ", t, f)")
+        .replace(", thin(c))", ", thin(c), f)")
+        .replace("(k, c, hx, hy, hz, om) = ", "(k, c, hx, hy, hz, om, f) = ")
+        .replace("(c, hx, hy, hz, om) = ", "(c, hx, hy, hz, om, f) = ")
+        .replace("lz + vz, om);", "lz + vz, om, phin(lx, ly, lz));");
+    let azimuth = "{ The light's azimuth phi_in (degrees) from u towards v = N x u, with N the\n  \
+        normal on the light's side; -1 where the orientation is along the normal. }\n\
+        phin(lx, ly, lz) = if(crl, azim(if(cosl(lx, ly, lz), 1, -1)*(lx*vhx + ly*vhy + lz*vhz),\n\
+        \tlx*uhx + ly*uhy + lz*uhz), -1);\n\
+        azim(y, x) : turn(atan2(y, x)/DEGREE);\n\
+        turn(a) : a - 360*floor(a/360);\n\n";
+    // After the geometry section, which defines the tangent frame.
+    match text.find("{ ===== 4.").or_else(|| text.find("{ ===== 5.")) {
+        Some(at) => format!("{}{azimuth}{}", &text[..at], &text[at..]),
+        None => format!("{azimuth}{text}"),
     }
 }

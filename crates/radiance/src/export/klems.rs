@@ -16,7 +16,7 @@
 
 use std::path::{Path, PathBuf};
 
-use brtf_fit::FitResult;
+use brtf_fit::{FitResult, azimuth_from_u};
 use brtf_gonio::klems::model_matrix::{self, SampleOptions, SideMatrices};
 use brtf_gonio::klems::{
     KlemsBand, KlemsBasis, KlemsDirection, KlemsWriteBlock, KlemsWriteHeader, Side, to_klems_xml,
@@ -157,11 +157,14 @@ fn side_from_fit(
 ) -> Result<SideModel, KlemsExportError> {
     let options = export_options(result);
     let mut bsdfs = Vec::with_capacity(basis.len());
+    let mirrored = result.is_mirrored_side();
     for patch in basis.patches() {
         let theta = patch.theta_deg;
+        // A patch's (θ, φ) is the direction of travel: the light is at φ + 180°.
+        let phi = azimuth_from_u(result.config.orientation, mirrored, patch.phi_deg + 180.0);
         let material = match &result.table {
             Some(table) => table
-                .at(theta)
+                .at_direction(theta, phi)
                 .map(|l| l.material)
                 .map_err(|e| e.to_string()),
             None => result

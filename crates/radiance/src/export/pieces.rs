@@ -182,6 +182,7 @@ mod tests {
 
     fn table(method: Interpolation) -> ParamTable {
         ParamTable {
+            azimuth: None,
             kind: MaterialKind::Plastic,
             orientation: [1.0, 0.0, 0.0],
             method,

@@ -26,6 +26,9 @@ use glam::DVec3;
 
 /// Samples per table segment when searching minima over θ_in.
 const GRID_PER_SEGMENT: usize = 400;
+/// The same for a (θ_in, φ_in) table, at this many azimuths (every 2.5°).
+const GRID_PER_SEGMENT_WITH_AZIMUTH: usize = 40;
+const GRID_AZIMUTHS: usize = 144;
 /// Rtrace's Fresnel switch (specularity at or above it, roughness 0).
 const FRESNEL_THRESHOLD: f64 = 0.017999;
 /// The constant diffuse parts are this fraction of the smallest diffuse
@@ -53,7 +56,9 @@ pub(crate) fn build(
     let grid = grid(table);
     let iso = !kind.is_anisotropic();
     let any_pure = iso && grid.iter().any(|a| a[4] * a[4] <= FTINY);
-    let lobe_only = variant != Variant::Ward1992 && !any_pure && only_roughness_varies(table);
+    let azimuth = table.depends_on_azimuth();
+    let lobe_only =
+        variant != Variant::Ward1992 && !any_pure && !azimuth && only_roughness_varies(table);
     let entry = if lobe_only {
         Entry::Lobe
     } else {
@@ -71,6 +76,7 @@ pub(crate) fn build(
         orientation: table.orientation,
         pieces: &pieces,
         entry,
+        azimuth: azimuth.then_some(table),
     };
     let cal_name = cal_file_name(name);
     let (lo, hi) = table.range();
@@ -291,17 +297,31 @@ fn check_rows(table: &ParamTable) -> Result<(), ExportError> {
     Ok(())
 }
 
-/// Interpolated arguments on a fine θ_in grid (nodes included).
+/// Interpolated arguments on a fine θ_in grid (nodes included); for a
+/// table that follows φ_in, on a (θ_in, φ_in) grid.
 fn grid(table: &ParamTable) -> Vec<Vec<f64>> {
+    let (per_segment, azimuths) = if table.depends_on_azimuth() {
+        (GRID_PER_SEGMENT_WITH_AZIMUTH, GRID_AZIMUTHS)
+    } else {
+        (GRID_PER_SEGMENT, 1)
+    };
+    let at = |t: f64, out: &mut Vec<Vec<f64>>| {
+        for k in 0..azimuths {
+            let phi = 360.0 * k as f64 / azimuths as f64;
+            out.push(table.args_at_direction(t, phi).0);
+        }
+    };
     let mut out = Vec::new();
     for w in table.theta_in.windows(2) {
-        for j in 0..GRID_PER_SEGMENT {
-            let t = w[0] + (w[1] - w[0]) * j as f64 / GRID_PER_SEGMENT as f64;
-            out.push(table.args_at(t).0);
+        for j in 0..per_segment {
+            at(
+                w[0] + (w[1] - w[0]) * j as f64 / per_segment as f64,
+                &mut out,
+            );
         }
     }
     if let Some(&last) = table.theta_in.last() {
-        out.push(table.args_at(last).0);
+        at(last, &mut out);
     }
     out
 }
