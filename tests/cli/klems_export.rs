@@ -572,6 +572,20 @@ fn anisotropic_fit_exports_the_parameters_of_each_azimuth() {
         .map(|r| r["phi_in"].as_array().unwrap().len())
         .collect();
     assert_eq!(counts, [1, 8, 16, 20, 24], "the Klems rings to 40°");
+    // At each fitted incidence the table gives that incidence's own fit.
+    let result = brtf_fit::FitResult::read(&fit_dir).unwrap();
+    for r in &result.incidences {
+        let m = result
+            .material_at_direction(r.theta_in, r.phi_in, None)
+            .unwrap();
+        for (a, b) in m.args().iter().zip(&r.material_args) {
+            assert!(
+                (a - b).abs() <= 1e-9 * b.abs().max(1e-3),
+                "{}: {a} vs {b}",
+                r.source
+            );
+        }
+    }
     // The same fit without the rings: φ_in-averaged rows only.
     let averaged_dir = tmp.path().join("averaged");
     std::fs::create_dir_all(&averaged_dir).unwrap();

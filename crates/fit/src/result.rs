@@ -327,6 +327,25 @@ impl FitResult {
             .or_else(|| self.static_material())
     }
 
+    /// [`Self::material_at`] for a light at (`theta_in`, `phi_in`), φ_in in
+    /// the data's frame (as [`FitReport::phi_in`]): a table that follows
+    /// φ_in gives its parameters at that azimuth.
+    pub fn material_at_direction(
+        &self,
+        theta_in: f64,
+        phi_in: f64,
+        report: Option<&FitReport>,
+    ) -> Option<Material> {
+        match &self.table {
+            Some(table) if table.depends_on_azimuth() => {
+                let phi =
+                    crate::azimuth_from_u(self.config.orientation, self.is_mirrored_side(), phi_in);
+                table.at_direction(theta_in, phi).ok().map(|l| l.material)
+            }
+            _ => self.material_at(theta_in, report),
+        }
+    }
+
     /// `params.csv`: one row per incidence, then the all-incidence fit as a
     /// row with θ_in `all`.
     pub fn params_csv(&self) -> Result<String, csv::Error> {

@@ -172,7 +172,7 @@ pub fn check_replaceable(target: &Path, inputs: &[PathBuf], force: bool) -> Resu
         .map(|b| crate::sha256_hex(&b))
         .collect();
     let file_name = |p: &str| Path::new(p).file_name().map(|n| n.to_os_string());
-    let others: Vec<&str> = recorded
+    let mut others: Vec<&str> = recorded
         .iter()
         .filter(|(path, sha)| {
             !digests.contains(sha)
@@ -182,16 +182,26 @@ pub fn check_replaceable(target: &Path, inputs: &[PathBuf], force: bool) -> Resu
         })
         .map(|(path, _)| path.as_str())
         .collect();
+    // A Klems fit records its file once per incident patch: name it once.
+    others.sort_unstable();
+    others.dedup();
     match (recorded.is_empty(), others.as_slice()) {
         (true, _) => Err(refuse(format!(
             "{} names no input files; --force replaces it",
             fit_json.display()
         ))),
         (false, []) => Ok(()),
-        (false, others) => Err(refuse(format!(
-            "it holds the fit of other measurements ({}); choose another output folder, or --force to replace it",
-            others.join(", ")
-        ))),
+        (false, others) => {
+            let listed = match others {
+                [a, b, c, d, rest @ ..] if !rest.is_empty() => {
+                    format!("{a}, {b}, {c}, {d} and {} more", rest.len())
+                }
+                all => all.join(", "),
+            };
+            Err(refuse(format!(
+                "it holds the fit of other measurements ({listed}); choose another output folder, or --force to replace it"
+            )))
+        }
     }
 }
 
@@ -575,6 +585,35 @@ mod tests {
         std::fs::write(&inside, b"c").unwrap();
         let err = check_replaceable(&target, &[inside], true).unwrap_err();
         assert!(err.to_string().contains("holds the input"), "{err}");
+    }
+
+    /// A Klems fit records its one file once per incident patch; the
+    /// refusal names each file once, and at most four of many.
+    #[test]
+    fn other_measurements_are_named_once_and_few() {
+        let root = tempfile::tempdir().unwrap();
+        let mine = root.path().join("mine.xml");
+        std::fs::write(&mine, b"mine").unwrap();
+        let target = root.path().join("fit");
+        std::fs::create_dir(&target).unwrap();
+        let patches: Vec<String> = (0..145)
+            .map(|_| format!(r#"{{"path": "shade.xml", "sha256": "{}"}}"#, "0".repeat(64)))
+            .collect();
+        let fit = format!(
+            r#"{{"provenance": {{"inputs": [{}]}}}}"#,
+            patches.join(", ")
+        );
+        std::fs::write(target.join("fit.json"), fit).unwrap();
+        let err = check_replaceable(&target, std::slice::from_ref(&mine), false).unwrap_err();
+        let text = err.to_string();
+        assert_eq!(text.matches("shade.xml").count(), 1, "{text}");
+        let many: Vec<String> = (0..7)
+            .map(|k| format!(r#"{{"path": "s{k}.mpc", "sha256": "{}"}}"#, "0".repeat(64)))
+            .collect();
+        let fit = format!(r#"{{"provenance": {{"inputs": [{}]}}}}"#, many.join(", "));
+        std::fs::write(target.join("fit.json"), fit).unwrap();
+        let err = check_replaceable(&target, std::slice::from_ref(&mine), false).unwrap_err();
+        assert!(err.to_string().contains("s3.mpc and 3 more"), "{err}");
     }
 
     #[test]
