@@ -28,6 +28,7 @@ impl Frame {
 
     /// Any frame with `z` (unit) as its third axis, without branches on
     /// the direction (Duff et al., "Building an Orthonormal Basis, Revisited", 2017).
+    #[inline]
     pub fn from_z(z: DVec3) -> Frame {
         debug_assert!((z.length() - 1.0).abs() < 1e-9, "frame axis is not unit");
         let sign = 1f64.copysign(z.z);

@@ -11,8 +11,9 @@ use std::io::Write;
 use std::time::{Duration, Instant};
 
 use crate::camera::Camera;
+use crate::direct::DirectRows;
 use crate::hdr::Picture;
-use crate::integrator::{DirectBatch, RayCounts, Settings, Tracer};
+use crate::integrator::{RayCounts, Settings, Tracer};
 use crate::rng::Rng;
 use crate::scene::Scene;
 
@@ -62,46 +63,44 @@ pub struct Rendered {
 pub fn render(scene: &Scene, camera: &Camera, options: &ImageOptions) -> Rendered {
     let start = Instant::now();
     let tracer = Tracer::new(scene, options.settings);
-    // Direct light only: a row's BSDF values in one vectorised batch.
-    let direct_batch = tracer.direct_batch_applies();
+    // Direct light only: whole rows through the vectorised pipeline.
+    let direct_rows = tracer.direct_batch_applies();
     let (w, h) = (options.width, options.height);
     let n = options.samples.max(1);
-    let rows: Vec<(Vec<[f32; 3]>, RayCounts)> = (0..h)
-        .into_par_iter()
-        // One batch buffer per worker, reused row after row.
-        .map_init(DirectRow::default, |direct, j| {
+    let mut pixels = vec![[0.0f32; 3]; w * h];
+    let rays = pixels
+        .par_chunks_mut(w.max(1))
+        .enumerate()
+        // One set of row buffers per worker, reused row after row.
+        .map_init(DirectRows::default, |direct, (j, row)| {
             let mut counts = RayCounts::default();
-            if direct_batch {
-                return (direct.row(&tracer, camera, options, j, &mut counts), counts);
+            if direct_rows {
+                direct.row(&tracer, camera, options, j, &mut counts, row);
+                return counts;
             }
-            let row = (0..w)
-                .map(|i| {
-                    let mut rng = Rng::new(options.seed, (j * w + i) as u64);
-                    let mut sum: Rgb = [0.0; 3];
-                    for _ in 0..n {
-                        let (du, dv) = if options.jitter {
-                            (rng.uniform(), rng.uniform())
-                        } else {
-                            (0.5, 0.5)
-                        };
-                        let ray = camera.pixel_ray(i, j, w, h, du, dv);
-                        let l = tracer.radiance(&ray, &mut rng, &mut counts);
-                        for k in 0..3 {
-                            sum[k] += l[k];
-                        }
+            for (i, pixel) in row.iter_mut().enumerate() {
+                let mut rng = Rng::new(options.seed, (j * w + i) as u64);
+                let mut sum: Rgb = [0.0; 3];
+                for _ in 0..n {
+                    let (du, dv) = if options.jitter {
+                        (rng.uniform(), rng.uniform())
+                    } else {
+                        (0.5, 0.5)
+                    };
+                    let ray = camera.pixel_ray(i, j, w, h, du, dv);
+                    let l = tracer.radiance(&ray, &mut rng, &mut counts);
+                    for k in 0..3 {
+                        sum[k] += l[k];
                     }
-                    sum.map(|s| (s / n as f64) as f32)
-                })
-                .collect();
-            (row, counts)
+                }
+                *pixel = sum.map(|s| (s / n as f64) as f32);
+            }
+            counts
         })
-        .collect();
-    let mut rays = RayCounts::default();
-    let mut pixels = Vec::with_capacity(w * h);
-    for (row, counts) in rows {
-        pixels.extend(row);
-        rays.add(&counts);
-    }
+        .reduce(RayCounts::default, |mut a, b| {
+            a.add(&b);
+            a
+        });
     Rendered {
         picture: Picture {
             width: w,
@@ -111,61 +110,6 @@ pub fn render(scene: &Scene, camera: &Camera, options: &ImageOptions) -> Rendere
         },
         rays,
         elapsed: start.elapsed(),
-    }
-}
-
-/// The buffers of [`DirectRow::row`], kept between rows.
-#[derive(Debug, Default)]
-struct DirectRow {
-    batch: Option<DirectBatch>,
-    radiance: Vec<Rgb>,
-}
-
-impl DirectRow {
-    /// Row `j` when the picture is direct light only: every camera ray of
-    /// the row is traced and its source samples queued, then their BSDF
-    /// values come from one batch evaluation and the shadow rays follow.
-    /// Draws the same random numbers in the same order as the per-ray loop.
-    fn row(
-        &mut self,
-        tracer: &Tracer,
-        camera: &Camera,
-        options: &ImageOptions,
-        j: usize,
-        counts: &mut RayCounts,
-    ) -> Vec<[f32; 3]> {
-        let (w, h) = (options.width, options.height);
-        let n = options.samples.max(1) as usize;
-        let batch = self.batch.get_or_insert_with(|| tracer.direct_batch());
-        let radiance = &mut self.radiance;
-        radiance.clear();
-        radiance.resize(w * n, [0.0; 3]);
-        for i in 0..w {
-            let mut rng = Rng::new(options.seed, (j * w + i) as u64);
-            for s in 0..n {
-                let (du, dv) = if options.jitter {
-                    (rng.uniform(), rng.uniform())
-                } else {
-                    (0.5, 0.5)
-                };
-                let ray = camera.pixel_ray(i, j, w, h, du, dv);
-                let slot = i * n + s;
-                radiance[slot] = tracer.direct_start(&ray, slot, &mut rng, counts, batch);
-            }
-        }
-        tracer.direct_finish(batch, radiance, counts);
-        radiance
-            .chunks_exact(n)
-            .map(|samples| {
-                let mut sum: Rgb = [0.0; 3];
-                for l in samples {
-                    for k in 0..3 {
-                        sum[k] += l[k];
-                    }
-                }
-                sum.map(|s| (s / n as f64) as f32)
-            })
-            .collect()
     }
 }
 

@@ -17,7 +17,7 @@
 //!
 //! Everything the tracer computes is counted in [`RayCounts`].
 
-use brtf_model::{Directions, Rgb, RgbBatch};
+use brtf_model::Rgb;
 use glam::DVec3;
 
 use crate::rng::Rng;
@@ -429,40 +429,11 @@ impl<'a> Tracer<'a> {
     }
 }
 
-/// A shadow ray whose BSDF value is still to come.
-#[derive(Debug, Clone, Copy)]
-struct PendingShadow {
-    /// Which camera ray (its index in the batch).
-    slot: usize,
-    /// Which source.
-    source: usize,
-    /// Which shader, and the pair's index in that shader's arrays.
-    shader: usize,
-    index: usize,
-    shadow: Ray,
-    distance: f64,
-    /// `|cos θ_l| ω`.
-    weight: f64,
-    radiance: Rgb,
-}
-
-/// Direct light for many camera rays at once: the (light, view) pairs of
-/// all their source samples are gathered per shader, evaluated with one
-/// [`brtf_model::Bsdf::eval_batch`] each, and only then are the shadow
-/// rays traced. Used by [`crate::render`] when [`Tracer::direct_batch_applies`].
-#[derive(Debug, Default)]
-pub(crate) struct DirectBatch {
-    lights: Vec<Directions>,
-    views: Vec<Directions>,
-    values: Vec<RgbBatch>,
-    pending: Vec<PendingShadow>,
-}
-
 impl Tracer<'_> {
     /// True when every camera ray's radiance is its first hit's direct
     /// term alone (no specular, diffuse or delta rays) and every shader
-    /// is one isotropic material, so that [`Self::direct_start`] +
-    /// [`Self::direct_finish`] give what [`Self::radiance`] gives (to the
+    /// is one isotropic material, so that the row pipeline of
+    /// [`crate::direct`] gives what [`Self::radiance`] gives (to the
     /// last bits of the batch BSDF, 1e-15 relative).
     pub(crate) fn direct_batch_applies(&self) -> bool {
         let s = &self.settings;
@@ -475,119 +446,13 @@ impl Tracer<'_> {
             })
     }
 
-    /// A batch for this scene's shaders.
-    pub(crate) fn direct_batch(&self) -> DirectBatch {
-        let n = self.scene.shaders.len();
-        DirectBatch {
-            lights: vec![Directions::default(); n],
-            views: vec![Directions::default(); n],
-            values: vec![RgbBatch::default(); n],
-            pending: Vec::new(),
-        }
-    }
-
-    /// The first part of [`Self::radiance`] for camera ray number `slot`:
-    /// the radiance of a ray that hits no surface, else 0 with its source
-    /// samples queued in `batch` (drawing the same random numbers).
-    pub(crate) fn direct_start(
+    /// A distant source's cone frame, `1 − cos` of its half-angle and
+    /// its solid angle (`None` for other sources).
+    #[inline]
+    pub(crate) fn distant_sampling(
         &self,
-        ray: &Ray,
-        slot: usize,
-        rng: &mut Rng,
-        counts: &mut RayCounts,
-        batch: &mut DirectBatch,
-    ) -> Rgb {
-        counts.primary += 1;
-        let (t, object) = match self.scene.intersect(ray) {
-            Hit::Light(radiance) => return radiance,
-            Hit::Escaped { source } => return source.unwrap_or(self.scene.background),
-            Hit::Surface { t, object } => (t, object),
-        };
-        let p = ray.origin + ray.dir * t;
-        let obj = &self.scene.objects[object];
-        let shader = &self.scene.shaders[obj.shader];
-        let v_world = -ray.dir;
-        let mut n = obj.shape.normal_at(p);
-        if n.dot(v_world) < 0.0 {
-            n = -n;
-        }
-        let (frame, _) = shader.frame(n);
-        let v = frame.to_local(v_world);
-        let v = DVec3::new(v.x, v.y, v.z.max(0.0));
-        let n_src = self.settings.source_samples.max(1);
-        for (source_index, source) in self.sources.iter().enumerate() {
-            for _ in 0..n_src {
-                let Some(sample) = source.sample(p, rng.uniform2()) else {
-                    continue;
-                };
-                let l = frame.to_local(sample.dir);
-                let side = if l.z >= 0.0 { n } else { -n };
-                batch.pending.push(PendingShadow {
-                    slot,
-                    source: source_index,
-                    shader: obj.shader,
-                    index: batch.lights[obj.shader].len(),
-                    shadow: Ray {
-                        origin: p + side * RAY_EPSILON,
-                        dir: sample.dir,
-                    },
-                    distance: sample.distance,
-                    weight: l.z.abs() * sample.omega,
-                    radiance: sample.radiance,
-                });
-                batch.lights[obj.shader].push(l);
-                batch.views[obj.shader].push(v);
-            }
-        }
-        [0.0; 3]
-    }
-
-    /// Evaluates the queued pairs, traces their shadow rays (only where
-    /// `f ≠ 0`, as [`Self::radiance`] does) and adds each camera ray's
-    /// direct term to `out[slot]`. Empties `batch`.
-    pub(crate) fn direct_finish(
-        &self,
-        batch: &mut DirectBatch,
-        out: &mut [Rgb],
-        counts: &mut RayCounts,
-    ) {
-        for (i, shader) in self.scene.shaders.iter().enumerate() {
-            if let Some(bsdf) = shader.single_bsdf()
-                && !batch.lights[i].is_empty()
-            {
-                bsdf.eval_batch(&batch.lights[i], &batch.views[i], &mut batch.values[i]);
-            }
-        }
-        let n_src = self.settings.source_samples.max(1) as f64;
-        let pending = &batch.pending;
-        let mut i = 0;
-        while i < pending.len() {
-            // One (camera ray, source) group, summed as `shade` sums it.
-            let (slot, source) = (pending[i].slot, pending[i].source);
-            let mut sum = [0.0; 3];
-            while i < pending.len() && pending[i].slot == slot && pending[i].source == source {
-                let job = &pending[i];
-                i += 1;
-                let f = batch.values[job.shader].get(job.index);
-                if f == [0.0; 3] {
-                    continue;
-                }
-                counts.shadow += 1;
-                if self.scene.occluded(&job.shadow, job.distance) {
-                    continue;
-                }
-                for k in 0..3 {
-                    sum[k] += f[k] * job.weight * job.radiance[k];
-                }
-            }
-            for k in 0..3 {
-                out[slot][k] += sum[k] / n_src;
-            }
-        }
-        batch.pending.clear();
-        for (l, v) in batch.lights.iter_mut().zip(&mut batch.views) {
-            l.clear();
-            v.clear();
-        }
+        source: usize,
+    ) -> Option<(crate::frame::Frame, f64, f64)> {
+        self.sources[source].distant()
     }
 }

@@ -38,6 +38,7 @@
 
 pub mod camera;
 pub mod check;
+mod direct;
 pub mod frame;
 pub mod gonio;
 pub mod hdr;

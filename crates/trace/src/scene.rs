@@ -249,6 +249,13 @@ impl PreparedSource {
         }
     }
 
+    /// A distant source's frame, `1 − cos` of its half-angle and its
+    /// solid angle.
+    #[inline]
+    pub(crate) fn distant(&self) -> Option<(Frame, f64, f64)> {
+        self.distant
+    }
+
     /// [`Source::sample`], the same numbers.
     #[inline]
     pub(crate) fn sample(&self, p: DVec3, u: [f64; 2]) -> Option<SourceSample> {

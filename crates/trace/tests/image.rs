@@ -135,16 +135,57 @@ fn lambertian_floor_under_a_sphere_light() {
     let _ = auto_exposure;
 }
 
-/// The batched direct-light rows (one `eval_batch` per row and shader)
-/// give every pixel and every ray count of the per-ray tracer.
+/// The direct-light rows (structure-of-arrays, one batch BSDF per row
+/// and shader) give every pixel and every ray count of the per-ray
+/// tracer: several shaders, a sphere light and a distant source, two
+/// source samples and three jittered camera rays per pixel.
 #[test]
 fn batched_direct_rows_equal_the_per_ray_tracer() {
+    let settings = Settings {
+        source_samples: 2,
+        ..Settings::direct_only()
+    };
+    let options = ImageOptions {
+        width: 48,
+        height: 36,
+        samples: 3,
+        jitter: true,
+        seed: 7,
+        settings,
+    };
+    direct_rows_equal_the_per_ray_tracer(&options, true);
+}
+
+/// The same with one centred camera ray per pixel, one source sample and
+/// one material (the benchmark's case: the rows skip dividing by 1 and
+/// evaluate the BSDF without gathering pairs by shader).
+#[test]
+fn batched_direct_rows_equal_the_per_ray_tracer_one_sample() {
+    let options = ImageOptions {
+        width: 64,
+        height: 48,
+        samples: 1,
+        jitter: false,
+        seed: 3,
+        settings: Settings::direct_only(),
+    };
+    direct_rows_equal_the_per_ray_tracer(&options, false);
+}
+
+/// Renders the test scene with a third sphere (of a second, transmitting
+/// material if `glass`, else of the first) and a sphere light, and
+/// compares every pixel with [`Tracer::radiance`].
+fn direct_rows_equal_the_per_ray_tracer(options: &ImageOptions, glass: bool) {
     use brtf_trace::integrator::RayCounts;
     use brtf_trace::{Rng, Tracer};
     let mut scene = scene();
     // A second, transmitting material lit from behind, and a sphere light.
-    let glass = mat(MaterialKind::Trans, &[0.7, 0.8, 0.9, 0.04, 0.05, 0.6, 0.3]);
-    let id = scene.add_shader(Shader::new(&glass, &EvalOptions::default()));
+    let id = if glass {
+        let glass = mat(MaterialKind::Trans, &[0.7, 0.8, 0.9, 0.04, 0.05, 0.6, 0.3]);
+        scene.add_shader(Shader::new(&glass, &EvalOptions::default()))
+    } else {
+        0
+    };
     scene.add(
         Shape::Sphere {
             center: DVec3::new(1.5, -1.0, 0.6),
@@ -157,27 +198,15 @@ fn batched_direct_rows_equal_the_per_ray_tracer() {
         radius: 0.5,
         radiance: [50.0, 40.0, 30.0],
     });
-    let (w, h) = (48, 36);
+    let (w, h) = (options.width, options.height);
     let camera = Camera::look_at(
         DVec3::new(6.0, -6.0, 4.0),
         DVec3::new(0.0, 0.0, 0.7),
         40.0,
         w as f64 / h as f64,
     );
-    let settings = Settings {
-        source_samples: 2,
-        ..Settings::direct_only()
-    };
-    let options = ImageOptions {
-        width: w,
-        height: h,
-        samples: 3,
-        jitter: true,
-        seed: 7,
-        settings,
-    };
-    let rendered = render(&scene, &camera, &options);
-    let tracer = Tracer::new(&scene, settings);
+    let rendered = render(&scene, &camera, options);
+    let tracer = Tracer::new(&scene, options.settings);
     let mut counts = RayCounts::default();
     let mut lit = 0;
     for j in 0..h {
@@ -185,7 +214,11 @@ fn batched_direct_rows_equal_the_per_ray_tracer() {
             let mut rng = Rng::new(options.seed, (j * w + i) as u64);
             let mut sum = [0.0; 3];
             for _ in 0..options.samples {
-                let (du, dv) = (rng.uniform(), rng.uniform());
+                let (du, dv) = if options.jitter {
+                    (rng.uniform(), rng.uniform())
+                } else {
+                    (0.5, 0.5)
+                };
                 let ray = camera.pixel_ray(i, j, w, h, du, dv);
                 let l = tracer.radiance(&ray, &mut rng, &mut counts);
                 for k in 0..3 {
