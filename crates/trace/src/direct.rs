@@ -467,19 +467,21 @@ impl DirectRows {
         let n = options.samples.max(1) as usize;
         let scene = tracer.scene;
         let arch = pulp::Arch::new();
-        if !options.jitter {
-            self.du.clear();
-            self.dv.clear();
-        }
 
-        // Camera rays (the jitter is the first draw of each pixel's stream).
-        self.du.resize(w, 0.5);
-        self.dv.resize(w, 0.5);
+        // Camera rays (the jitter is the first draw of each pixel's stream;
+        // without it every ray goes through its pixel's centre).
         if options.jitter {
+            self.du.resize(w, 0.0);
+            self.dv.resize(w, 0.0);
             for (i, rng) in self.rngs.iter_mut().enumerate() {
                 self.du[i] = rng.uniform();
                 self.dv[i] = rng.uniform();
             }
+        } else {
+            self.du.clear();
+            self.du.resize(w, 0.5);
+            self.dv.clear();
+            self.dv.resize(w, 0.5);
         }
         self.origins.resize(w);
         self.dirs.resize(w);
