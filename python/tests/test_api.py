@@ -169,3 +169,23 @@ def test_fit_releases_the_gil(golden_paper):
     # The main thread kept running Python while the fit ran.
     assert ticks > 20
     assert result["fit"].incidences[0].converged
+
+
+def test_material_at_follows_the_azimuth_of_an_anisotropic_klems_fit(cli, klems_fabric, tmp_path):
+    """A trans2 fitted to Klems rings: `material_at(θ, φ)` gives each
+    fitted incidence its own parameters, as every brtf command does; the
+    rows averaged over φ_in differ from them."""
+    out = tmp_path / "mecho"
+    run_cli(
+        cli, "fit", klems_fabric, "--model", "trans2", "--gray", "--side", "front",
+        "--incidences", "theta<=20", "--no-plots", "--no-export", "--no-adequacy", "--out", out,
+    )
+    fit = brtf.Fit.load(out)
+    differs = 0
+    for inc in fit.incidences:
+        at = fit.material_at(inc.theta_in, inc.phi_in)
+        assert at.args == pytest.approx(inc.material_args, rel=1e-9, abs=1e-12)
+        mean = fit.material_at(inc.theta_in)
+        if abs(mean.args[6] - inc.material_args[6]) > 1e-3 * inc.material_args[6]:
+            differs += 1
+    assert differs > 10, differs

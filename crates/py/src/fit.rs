@@ -535,16 +535,28 @@ impl Fit {
         Ok(d)
     }
 
-    /// The material at θ_in from the table (with the fit's options).
-    fn material_at(&self, theta_in: f64) -> PyResult<Material> {
+    /// The material at θ_in from the table (with the fit's options); with
+    /// `phi_in` (degrees, the data's frame), at that azimuth for a table
+    /// that follows φ_in (anisotropic types fitted to Klems XML).
+    #[pyo3(signature = (theta_in, phi_in=None))]
+    fn material_at(&self, theta_in: f64, phi_in: Option<f64>) -> PyResult<Material> {
         let table = self.result.table.as_ref().ok_or_else(|| {
             errors::error(Class::Fit, "this fit has no θ_in table".into(), None, None)
         })?;
-        let lookup = table
-            .at(theta_in)
-            .map_err(|e| errors::model(e.to_string()))?;
+        let material = match phi_in {
+            Some(phi) => self
+                .result
+                .material_at_direction(theta_in, phi, None)
+                .ok_or_else(|| errors::model(format!("no material at ({theta_in}°, {phi}°)")))?,
+            None => {
+                table
+                    .at(theta_in)
+                    .map_err(|e| errors::model(e.to_string()))?
+                    .material
+            }
+        };
         Ok(Material::from_model(
-            lookup.material,
+            material,
             &self.result.options(),
             Some(self.result.name.clone()),
         ))

@@ -230,7 +230,7 @@ pub fn check_fit(
     for (index, report) in fit.incidences.iter().enumerate() {
         let directions = fitted_directions(fit, index, dir, options)?;
         let material = fit
-            .material_at(report.theta_in, Some(report))
+            .material_at_direction(report.theta_in, report.phi_in, Some(report))
             .ok_or(CheckError::NoMaterial)?;
         let mut row = render(&material, &directions, RowKind::Fitted);
         row.fit_rms = Some(report.rms_rel);
@@ -246,7 +246,9 @@ pub fn check_fit(
             for k in 1..=options.intermediate {
                 let t = lo.theta_in
                     + (hi.theta_in - lo.theta_in) * k as f64 / (options.intermediate + 1) as f64;
-                let material = fit.material_at(t, None).ok_or(CheckError::NoMaterial)?;
+                let material = fit
+                    .material_at_direction(t, lo.phi_in, None)
+                    .ok_or(CheckError::NoMaterial)?;
                 // The neighbour's directions, minus those near this beam.
                 let between = Directions {
                     theta_in: t,
