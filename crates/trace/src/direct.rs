@@ -132,6 +132,20 @@ stage!(Shadows {
 type Xyz<'a> = [&'a [f64]; 3];
 type XyzMut<'a> = [&'a mut [f64]; 3];
 
+/// `v` cut to `n` entries: with every array's length known to be the
+/// loop's, the compiler drops the bounds checks, which would otherwise
+/// keep the loop from vectorising.
+#[inline(always)]
+fn cut(v: Xyz, n: usize) -> Xyz {
+    [&v[0][..n], &v[1][..n], &v[2][..n]]
+}
+
+#[inline(always)]
+fn cut_mut(v: XyzMut, n: usize) -> XyzMut {
+    let [x, y, z] = v;
+    [&mut x[..n], &mut y[..n], &mut z[..n]]
+}
+
 #[inline(always)]
 fn at(v: &Xyz, i: usize) -> DVec3 {
     DVec3::new(v[0][i], v[1][i], v[2][i])
@@ -223,10 +237,11 @@ fn camera_rays(
     camera: &Camera,
     (j, w, h): (usize, usize, usize),
     (du, dv): (&[f64], &[f64]),
-    mut origins: XyzMut,
-    mut dirs: XyzMut,
+    origins: XyzMut,
+    dirs: XyzMut,
 ) {
     let (du, dv) = (&du[..w], &dv[..w]);
+    let (mut origins, mut dirs) = (cut_mut(origins, w), cut_mut(dirs, w));
     for i in 0..w {
         let ray = camera.pixel_ray(i, j, w, h, du[i], dv[i]);
         put(&mut origins, i, ray.origin);
@@ -264,10 +279,17 @@ fn nearest(
 fn shading(
     (hit_t, hit_sphere, hit_point): (&[f64], &[bool], Xyz),
     (hit_origin, hit_dir): (Xyz, Xyz),
-    [mut points, mut normals, mut frame_x, mut frame_y, mut views]: [XyzMut; 5],
+    out: [XyzMut; 5],
 ) {
     let hits = hit_t.len();
-    let hit_sphere = &hit_sphere[..hits];
+    let (hit_sphere, hit_point) = (&hit_sphere[..hits], cut(hit_point, hits));
+    let (hit_origin, hit_dir) = (cut(hit_origin, hits), cut(hit_dir, hits));
+    let [points, normals, frame_x, frame_y, views] = out;
+    let mut points = cut_mut(points, hits);
+    let mut normals = cut_mut(normals, hits);
+    let mut frame_x = cut_mut(frame_x, hits);
+    let mut frame_y = cut_mut(frame_y, hits);
+    let mut views = cut_mut(views, hits);
     for h in 0..hits {
         let dir = at(&hit_dir, h);
         let p = at(&hit_origin, h) + dir * hit_t[h];
@@ -292,14 +314,10 @@ fn shading(
 
 /// `uniform_cone_in` of a distant source for uniforms `(u0, u1)`.
 #[inline(always)]
-fn cone_samples(
-    frame: &Frame,
-    one_minus_cos_half: f64,
-    (u0, u1): (&[f64], &[f64]),
-    mut dirs: XyzMut,
-) {
+fn cone_samples(frame: &Frame, one_minus_cos_half: f64, (u0, u1): (&[f64], &[f64]), dirs: XyzMut) {
     let n = u0.len();
     let u1 = &u1[..n];
+    let mut dirs = cut_mut(dirs, n);
     for k in 0..n {
         let cos_t = 1.0 - u0[k] * one_minus_cos_half;
         let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
@@ -320,13 +338,17 @@ fn locals(
     sample_dirs: Xyz,
     (points, normals, frame_x, frame_y): (Xyz, Xyz, Xyz, Xyz),
     (omega, distance): (&[f64], &[f64]),
-    mut lights: XyzMut,
-    mut shadow_origins: XyzMut,
+    lights: XyzMut,
+    shadow_origins: XyzMut,
     weight: &mut [f64],
     t_max: &mut [f64],
 ) {
     let hits = weight.len();
     let (omega, distance, t_max) = (&omega[..hits], &distance[..hits], &mut t_max[..hits]);
+    let sample_dirs = cut(sample_dirs, hits);
+    let (points, normals) = (cut(points, hits), cut(normals, hits));
+    let (frame_x, frame_y) = (cut(frame_x, hits), cut(frame_y, hits));
+    let (mut lights, mut shadow_origins) = (cut_mut(lights, hits), cut_mut(shadow_origins, hits));
     for h in 0..hits {
         let n = at(&normals, h);
         let frame = Frame {
