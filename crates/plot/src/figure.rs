@@ -232,6 +232,9 @@ pub fn encode_png(w: u32, h: u32, colour: png::ColorType, data: &[u8]) -> Result
     let mut encoder = png::Encoder::new(&mut out, w, h);
     encoder.set_color(colour);
     encoder.set_depth(png::BitDepth::Eight);
+    // Fast: fdeflate with the adaptive filter. (Fastest, the Up filter
+    // alone, saves about 3 ms over all plots of a 127k-point scan but
+    // makes the charts' PNGs up to twice as large.)
     encoder.set_compression(png::Compression::Fast);
     let mut writer = encoder.write_header().msg()?;
     writer.write_image_data(data).msg()?;
@@ -275,14 +278,23 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), PlotError> {
         })
 }
 
+/// Renders `chart` as `<dir>/<name>.svg` and `<dir>/<name>.png`: each
+/// path with its bytes, not yet written.
+pub fn render_files(chart: &impl Chart, dir: &Path) -> Result<Vec<(PathBuf, Vec<u8>)>, PlotError> {
+    let (svg, png) = rayon::join(|| render_svg(chart), || render_png(chart));
+    Ok(vec![
+        (dir.join(format!("{}.svg", chart.name())), svg?.into_bytes()),
+        (dir.join(format!("{}.png", chart.name())), png?),
+    ])
+}
+
 /// Renders `chart` and writes `<dir>/<name>.svg` and `<dir>/<name>.png`.
 pub fn write_chart(chart: &impl Chart, dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
-    let (svg, png) = rayon::join(|| render_svg(chart), || render_png(chart));
-    let svg_path = dir.join(format!("{}.svg", chart.name()));
-    let png_path = dir.join(format!("{}.png", chart.name()));
-    write_atomic(&svg_path, svg?.as_bytes())?;
-    write_atomic(&png_path, &png?)?;
-    Ok(vec![svg_path, png_path])
+    let files = render_files(chart, dir)?;
+    for (path, bytes) in &files {
+        write_atomic(path, bytes)?;
+    }
+    Ok(files.into_iter().map(|(path, _)| path).collect())
 }
 
 #[cfg(test)]

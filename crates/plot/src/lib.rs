@@ -50,10 +50,11 @@ pub use error::PlotError;
 pub use klems::klems_sides_report;
 
 use brtf_fit::{FitResult, PreparedMeasurement};
+use brtf_gonio::Hemisphere;
 use charts::cut::{CutChart, CutsChart};
 use charts::map::MapChart;
 use charts::theta::{ParamsChart, RhoChart, RmsChart};
-use figure::{Chart, write_atomic, write_chart};
+use figure::{Chart, render_files, write_atomic};
 use prepare::{DataUnit, Incidence};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -143,16 +144,86 @@ enum Job<'a> {
 }
 
 impl Job<'_> {
-    fn write(&self, dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
+    fn render(&self, dir: &Path) -> Result<Vec<(PathBuf, Vec<u8>)>, PlotError> {
         match self {
-            Job::Map(c) => write_chart(c, dir),
-            Job::Cut(c) => write_chart(c, dir),
-            Job::Cuts(c) => write_chart(c, dir),
-            Job::Params(c) => write_chart(c, dir),
-            Job::Rho(c) => write_chart(c, dir),
-            Job::Rms(c) => write_chart(c, dir),
+            Job::Map(c) => render_files(c, dir),
+            Job::Cut(c) => render_files(c, dir),
+            Job::Cuts(c) => render_files(c, dir),
+            Job::Params(c) => render_files(c, dir),
+            Job::Rho(c) => render_files(c, dir),
+            Job::Rms(c) => render_files(c, dir),
         }
     }
+
+    /// The chart draws the nearest-sample grids ([`Incidence::coverage`]).
+    fn needs_coverage(&self) -> bool {
+        matches!(self, Job::Map(_) | Job::Rho(_))
+    }
+}
+
+/// Renders every job and writes its files; returns the paths in `jobs` order.
+/// The nearest-sample grids of `incs` are made at the same time as the
+/// charts that do not need them, so both cores stay busy; the charts
+/// that do need them follow. The files are written by a thread of their
+/// own, so that rendering never waits for the disk (each write syncs).
+fn render_and_write(
+    jobs: &[Job],
+    incs: &[&Incidence],
+    dir: &Path,
+) -> Result<Vec<PathBuf>, PlotError> {
+    std::thread::scope(|scope| {
+        let (send, receive) = std::sync::mpsc::channel::<(PathBuf, Vec<u8>)>();
+        let writer = scope.spawn(move || {
+            // The first failure is kept; nothing after it is written.
+            let mut outcome = Ok(());
+            for (path, bytes) in receive {
+                if outcome.is_ok() {
+                    outcome = write_atomic(&path, &bytes);
+                }
+            }
+            outcome
+        });
+        let render = |job: &Job| -> Result<Vec<PathBuf>, PlotError> {
+            let files = job.render(dir)?;
+            let paths = files.iter().map(|(p, _)| p.clone()).collect();
+            for file in files {
+                // The writer only stops early on a failure, reported below.
+                let _ = send.send(file);
+            }
+            Ok(paths)
+        };
+        let phase = |grids: bool| -> Vec<(usize, Result<Vec<PathBuf>, PlotError>)> {
+            jobs.par_iter()
+                .enumerate()
+                .filter(|(_, j)| j.needs_coverage() == grids)
+                .map(|(k, j)| (k, render(j)))
+                .collect()
+        };
+        let (mut rendered, ()) = rayon::join(
+            || phase(false),
+            || {
+                incs.par_iter().for_each(|inc| {
+                    [Hemisphere::Front, Hemisphere::Back]
+                        .par_iter()
+                        .for_each(|h| {
+                            inc.coverage(*h);
+                        })
+                })
+            },
+        );
+        rendered.extend(phase(true));
+        drop(send);
+        let written = writer
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        rendered.sort_by_key(|(k, _)| *k);
+        let mut files = Vec::new();
+        for (_, r) in rendered {
+            files.extend(r?);
+        }
+        written?;
+        Ok(files)
+    })
 }
 
 /// Draws every plot of `result` into `<dir>/plots/` and writes
@@ -307,12 +378,7 @@ fn plot(
         jobs.push(Job::Cuts(cuts));
     }
 
-    let written: Vec<Result<Vec<PathBuf>, PlotError>> =
-        jobs.par_iter().map(|j| j.write(&plots)).collect();
-    let mut files = Vec::new();
-    for w in written {
-        files.extend(w?);
-    }
+    let mut files = render_and_write(&jobs, &incs, &plots)?;
     remove_stale(&plots, &files);
 
     let entries = result

@@ -42,6 +42,9 @@ pub struct PlotSample {
     /// Index into [`Incidence::gates`] of the gate that removed the
     /// sample, `None` when it was fitted.
     pub removed_by: Option<usize>,
+    /// `ln((model + floor)/(data + floor))` (data clamped at 0), with the
+    /// incidence's floor: see [`Incidence::log_ratio`].
+    pub log_ratio: f64,
 }
 
 impl PlotSample {
@@ -89,6 +92,23 @@ pub struct Incidence {
     coverage: [OnceLock<Coverage>; 2],
     /// The samples near the plane of incidence, for the cuts.
     near_plane: OnceLock<Vec<(f64, f64, usize)>>,
+    /// The cut of the first requested plane tolerance, with that request:
+    /// the cut's SVG and PNG and the chart of all cuts share it.
+    cut: OnceLock<(Option<f64>, CutCache)>,
+}
+
+/// A cut of one incidence as [`crate::charts::cut::CutData`] shows it, with
+/// samples as indices into [`Incidence::samples`].
+#[derive(Debug, Clone)]
+pub struct CutCache {
+    /// Plane tolerance in degrees.
+    pub tolerance: f64,
+    /// `(x, sample index)` for the samples drawn.
+    pub points: Vec<(f64, usize)>,
+    /// The model along the plane: `(x, value)`.
+    pub curve: Vec<(f64, f64)>,
+    /// The x range.
+    pub range: (f64, f64),
 }
 
 impl Incidence {
@@ -126,6 +146,22 @@ impl Incidence {
         make: impl FnOnce() -> Vec<(f64, f64, usize)>,
     ) -> &[(f64, f64, usize)] {
         self.near_plane.get_or_init(make)
+    }
+
+    /// The cut for plane tolerance `tolerance` (`None`: automatic), made
+    /// by `make`: once for the first tolerance asked for (every chart of a
+    /// run asks for the same), afresh for any other.
+    pub(crate) fn cut(
+        &self,
+        tolerance: Option<f64>,
+        make: impl Fn() -> CutCache,
+    ) -> std::borrow::Cow<'_, CutCache> {
+        let (key, made) = self.cut.get_or_init(|| (tolerance, make()));
+        if *key == tolerance {
+            std::borrow::Cow::Borrowed(made)
+        } else {
+            std::borrow::Cow::Owned(make())
+        }
     }
 
     /// Model value `scale × f` (channel mean) for direction `v`.
@@ -167,10 +203,18 @@ impl Incidence {
         DVec3::new(-self.light.x, -self.light.y, self.light.z)
     }
 
-    /// `ln((model + floor)/(data + floor))` of a sample (data clamped at 0).
+    /// `ln((model + floor)/(data + floor))` of a sample (data clamped at
+    /// 0), with [`Incidence::floor`]; made once per sample when the
+    /// incidence is built (the maps, the colour bar and the statistics all
+    /// read it).
     pub fn log_ratio(&self, s: &PlotSample) -> f64 {
-        ((s.model.max(0.0) + self.floor) / (s.data.max(0.0) + self.floor)).ln()
+        s.log_ratio
     }
+}
+
+/// `ln((model + floor)/(data + floor))`, data clamped at 0.
+fn log_ratio(data: f64, model: f64, floor: f64) -> f64 {
+    ((model.max(0.0) + floor) / (data.max(0.0) + floor)).ln()
 }
 
 /// Reads the file of `report`, applies the fit's recipe and builds the
@@ -247,6 +291,7 @@ fn build(
 
     let floor = report.floor;
     let floor2 = floor * floor;
+    let incident = m.incident_direction();
     // Every sample with the model next to it, in parallel; the squared
     // relative errors of the fitted ones (per channel) are summed
     // afterwards in sample order.
@@ -258,8 +303,12 @@ fn build(
         .with_min_len(4096)
         .map(|(i, (s, removed))| {
             let dir = s.direction();
-            // Patch-averaged (Klems) data are compared with the averaged model.
-            let f = prepared.model_value(&bsdf, i);
+            // Patch-averaged (Klems) data are compared with the averaged
+            // model; else `model_value` is the BSDF at `dir` (computed once).
+            let f = match prepared.patch_pairs {
+                Some(_) => prepared.model_value(&bsdf, i),
+                None => bsdf.eval(incident, dir),
+            };
             let mut data = 0.0;
             let mut model = 0.0;
             let mut rel = [0.0; 3];
@@ -272,13 +321,15 @@ fn build(
                 data += y;
                 model += mv;
             }
+            let (data, model) = (data / channels as f64, model / channels as f64);
             let sample = PlotSample {
                 theta: s.theta_deg,
                 phi: s.phi_deg,
                 dir,
-                data: data / channels as f64,
-                model: model / channels as f64,
+                data,
+                model,
                 removed_by: *removed,
+                log_ratio: log_ratio(data, model, floor),
             };
             (sample, removed.is_none().then_some(rel))
         })
@@ -333,13 +384,8 @@ fn build(
         warnings,
         coverage: Default::default(),
         near_plane: OnceLock::new(),
+        cut: OnceLock::new(),
     };
-    // The nearest-sample grids now, with every thread: the map's SVG and
-    // PNG and the reflectance chart all need them, and drawn in parallel
-    // they would wait for one another.
-    for hemisphere in [Hemisphere::Front, Hemisphere::Back] {
-        incidence.coverage(hemisphere);
-    }
     Ok(incidence)
 }
 

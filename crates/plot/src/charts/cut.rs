@@ -16,7 +16,7 @@ use super::{
 };
 use crate::colour::{self, DATA, GUIDE, MASKED, MODEL, SHADE};
 use crate::figure::{Area, Canvas, Chart, FONT, OrMsg};
-use crate::prepare::{Incidence, PlotSample};
+use crate::prepare::{CutCache, Incidence, PlotSample};
 use glam::DVec3;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
@@ -104,11 +104,28 @@ pub struct CutData<'a> {
 
 impl<'a> CutData<'a> {
     /// Picks the samples near the plane and evaluates the model along it.
+    /// Made once per incidence and tolerance: the cut's SVG and PNG and the
+    /// chart of all cuts share it.
     pub fn of(inc: &'a Incidence, tolerance: Option<f64>) -> CutData<'a> {
+        let made = inc.cut(tolerance, || CutData::make(inc, tolerance));
+        CutData {
+            tolerance: made.tolerance,
+            points: made
+                .points
+                .iter()
+                .map(|&(x, k)| (x, &inc.samples[k]))
+                .collect(),
+            curve: made.curve.clone(),
+            range: made.range,
+        }
+    }
+
+    /// The cut of `inc` with samples as indices into `inc.samples`.
+    fn make(inc: &Incidence, tolerance: Option<f64>) -> CutCache {
         let plane = Plane::of(inc);
         // Made once per incidence: the cut's SVG and PNG and the chart of
         // all cuts each need them.
-        let near: Vec<(f64, f64, &PlotSample)> = inc
+        let near: Vec<(f64, f64, usize, &PlotSample)> = inc
             .near_plane(|| {
                 inc.samples
                     .par_iter()
@@ -120,14 +137,14 @@ impl<'a> CutData<'a> {
                     .collect()
             })
             .iter()
-            .map(|&(o, x, k)| (o, x, &inc.samples[k]))
+            .map(|&(o, x, k)| (o, x, k, &inc.samples[k]))
             .collect();
         // The smallest tolerance with enough fitted samples that also covers
         // (in 2° bins of x) nearly all of what the widest one covers.
         let coverage = |t: f64| -> (usize, usize) {
             let mut bins = std::collections::BTreeSet::new();
             let mut count = 0;
-            for (o, x, s) in &near {
+            for (o, x, _, s) in &near {
                 if *o <= t && s.used() {
                     count += 1;
                     bins.insert((x / 2.0).floor() as i64);
@@ -150,21 +167,20 @@ impl<'a> CutData<'a> {
         // One sample per bin of x, the one nearest the plane: on dense
         // layouts (pgII rings) the samples a few degrees off the plane sit
         // below the in-plane values at the same x and draw a comb.
-        let mut nearest: std::collections::BTreeMap<i64, (f64, f64, &PlotSample)> =
+        let mut nearest: std::collections::BTreeMap<i64, (f64, f64, usize, &PlotSample)> =
             std::collections::BTreeMap::new();
-        for (o, x, s) in near
+        for (o, x, k, s) in near
             .into_iter()
-            .filter(|(o, x, _)| *o <= tolerance && (range.0..=range.1).contains(x))
+            .filter(|(o, x, _, _)| *o <= tolerance && (range.0..=range.1).contains(x))
         {
             let bin = (x / CUT_BIN_DEG).floor() as i64;
-            let slot = nearest.entry(bin).or_insert((o, x, s));
+            let slot = nearest.entry(bin).or_insert((o, x, k, s));
             // Fitted samples first, then the nearest to the plane.
-            if (s.used(), -o) > (slot.2.used(), -slot.0) {
-                *slot = (o, x, s);
+            if (s.used(), -o) > (slot.3.used(), -slot.0) {
+                *slot = (o, x, k, s);
             }
         }
-        let points: Vec<(f64, &PlotSample)> =
-            nearest.into_values().map(|(_, x, s)| (x, s)).collect();
+        let points: Vec<(f64, usize)> = nearest.into_values().map(|(_, x, k, _)| (x, k)).collect();
         let steps = if back { 2880 } else { 1440 };
         let curve = (0..=steps)
             .map(|k| {
@@ -172,7 +188,7 @@ impl<'a> CutData<'a> {
                 (x, inc.model_at(plane.direction(x)))
             })
             .collect();
-        CutData {
+        CutCache {
             tolerance,
             points,
             curve,

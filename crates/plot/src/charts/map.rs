@@ -48,6 +48,43 @@ pub struct MapChart<'a> {
     rasters: Mutex<Vec<(RasterKey, SharedRaster)>>,
     /// Every sample's colour, made once for all rasters.
     colours: OnceLock<Vec<[u8; 3]>>,
+    /// The panel's numbers, made once for the SVG and the PNG.
+    stats: OnceLock<Stats>,
+}
+
+/// The panel's numbers of the fitted samples.
+#[derive(Debug, Clone, Copy)]
+struct Stats {
+    /// How many.
+    used: usize,
+    /// The median |log ratio| (the upper median: element n/2 in order).
+    median: f64,
+    /// How many are within ±10 % (|log ratio| ≤ ln 1.1).
+    within: usize,
+}
+
+impl Stats {
+    fn of(inc: &Incidence) -> Stats {
+        let mut used: Vec<f64> = inc
+            .samples
+            .iter()
+            .filter(|s| s.used())
+            .map(|s| inc.log_ratio(s).abs())
+            .collect();
+        let within = used.iter().filter(|a| **a <= 1.1f64.ln()).count();
+        let k = used.len() / 2;
+        // The same element a full sort would put at k, without the sort.
+        let median = if used.is_empty() {
+            f64::NAN
+        } else {
+            *used.select_nth_unstable_by(k, f64::total_cmp).1
+        };
+        Stats {
+            used: used.len(),
+            median,
+            within,
+        }
+    }
 }
 
 impl<'a> MapChart<'a> {
@@ -60,6 +97,7 @@ impl<'a> MapChart<'a> {
             rms_rel,
             rasters: Mutex::new(Vec::new()),
             colours: OnceLock::new(),
+            stats: OnceLock::new(),
         }
     }
 
@@ -368,34 +406,24 @@ impl<'a> MapChart<'a> {
         }
 
         // Numbers.
-        let used: Vec<f64> = self
-            .inc
-            .samples
-            .iter()
-            .filter(|s| s.used())
-            .map(|s| self.inc.log_ratio(s).abs())
-            .collect();
-        let mut sorted = used.clone();
-        sorted.sort_by(f64::total_cmp);
-        let median = sorted.get(sorted.len() / 2).copied().unwrap_or(f64::NAN);
-        let within = used.iter().filter(|a| **a <= 1.1f64.ln()).count();
+        let Stats {
+            used,
+            median,
+            within,
+        } = *self.stats.get_or_init(|| Stats::of(self.inc));
         let unit = match &self.inc.unit {
             DataUnit::Bsdf => "1/sr".to_string(),
             DataUnit::RawPerCos(u) => u.clone(),
         };
         let lines = [
-            format!(
-                "fitted samples: {} of {}",
-                used.len(),
-                self.inc.samples.len()
-            ),
+            format!("fitted samples: {} of {}", used, self.inc.samples.len()),
             format!(
                 "median |model ÷ data − 1|: {:.1} %",
                 100.0 * (median.exp() - 1.0)
             ),
             format!(
                 "within ±10 %: {:.0} % of the fitted",
-                100.0 * within as f64 / used.len().max(1) as f64
+                100.0 * within as f64 / used.max(1) as f64
             ),
             format!("RMS relative error: {}", fmt(self.rms_rel)),
             format!("floor added to both: {} {unit}", fmt(self.inc.floor)),
