@@ -126,6 +126,12 @@ pub(crate) fn build(
                 .join(" ")
         ));
     }
+    if azimuth {
+        ch.push(
+            "Rows with several azimuths show their mean; the parameters follow phi_in too".into(),
+        );
+        ch.push("(section 1b), each row's incidences at their azimuths.".into());
+    }
     ch.push("Fit quality per incidence:".into());
     ch.extend(report::incidences(result));
     ch.push(String::new());
