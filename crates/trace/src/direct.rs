@@ -290,6 +290,7 @@ fn shading(
     let mut frame_x = cut_mut(frame_x, hits);
     let mut frame_y = cut_mut(frame_y, hits);
     let mut views = cut_mut(views, hits);
+    // Two loops, each small enough for the compiler to vectorise.
     for h in 0..hits {
         let dir = at(&hit_dir, h);
         let p = at(&hit_origin, h) + dir * hit_t[h];
@@ -297,15 +298,17 @@ fn shading(
         let point = at(&hit_point, h);
         let radial = (p - point).normalize();
         let mut n = if hit_sphere[h] { radial } else { point };
-        let v_world = -dir;
-        if n.dot(v_world) < 0.0 {
+        if n.dot(-dir) < 0.0 {
             n = -n;
         }
-        let frame = Frame::from_z(n);
-        let v = frame.to_local(v_world);
-        let v = DVec3::new(v.x, v.y, v.z.max(0.0));
         put(&mut points, h, p);
         put(&mut normals, h, n);
+    }
+    for h in 0..hits {
+        let v_world = -at(&hit_dir, h);
+        let frame = Frame::from_z(at(&normals.each_ref().map(|c| &c[..]), h));
+        let v = frame.to_local(v_world);
+        let v = DVec3::new(v.x, v.y, v.z.max(0.0));
         put(&mut frame_x, h, frame.x);
         put(&mut frame_y, h, frame.y);
         put(&mut views, h, v);
