@@ -211,5 +211,8 @@ def fit(
     free_scale: bool = False,
     interpolation: Literal["pchip", "linear"] = "pchip",
     adequacy: bool = True,
+    side: Optional[Literal["front", "back"]] = None,
+    incidences: Optional[str] = None,
+    patch_samples: int = 32,
     jobs: Optional[int] = None,
 ) -> Fit: ...

@@ -51,7 +51,8 @@ def test_read_klems(klems_fabric):
     assert front[0].path is None and len(front[0]) == 290  # reflection + transmission patches
     with pytest.raises(brtf.FitError, match="Klems patch"):
         brtf.fit(front[0])
-    with pytest.raises(brtf.FitError, match="brtf fit FILE.xml"):
+    # The file itself is fitted one side at a time (test_fit_of_a_klems_side_equals_the_cli).
+    with pytest.raises(brtf.ModelError, match="one side at a time"):
         brtf.fit(klems_fabric)
 
 
@@ -189,3 +190,21 @@ def test_material_at_follows_the_azimuth_of_an_anisotropic_klems_fit(cli, klems_
         if abs(mean.args[6] - inc.material_args[6]) > 1e-3 * inc.material_args[6]:
             differs += 1
     assert differs > 10, differs
+
+
+def test_fit_of_a_klems_side_equals_the_cli(cli, klems_fabric, tmp_path):
+    """`brtf.fit(xml, side=...)` is `brtf fit xml --side ...`: the same
+    patch-averaged fits, parameter for parameter; a side is required."""
+    fit = brtf.fit(klems_fabric, model="trans", gray=True, side="back", incidences="theta<=10", adequacy=False)
+    out = tmp_path / "cli"
+    run_cli(
+        cli, "fit", klems_fabric, "--model", "trans", "--gray", "--side", "back",
+        "--incidences", "theta<=10", "--no-plots", "--no-export", "--no-adequacy", "--out", out,
+    )
+    want = json.loads((out / "fit.json").read_text())
+    assert fit.to_dict()["recipe"]["patch_average"] == want["recipe"]["patch_average"]
+    assert len(fit.incidences) == len(want["incidences"]) == 9
+    for got, ref in zip(fit.incidences, want["incidences"]):
+        assert got.material_args == pytest.approx(ref["material_args"], rel=1e-12, abs=1e-15)
+    with pytest.raises(brtf.ModelError, match="one side at a time"):
+        brtf.fit(klems_fabric, model="trans")

@@ -54,6 +54,23 @@ pub struct FitSetOptions {
     pub klems: KlemsOptions,
 }
 
+impl FitSetOptions {
+    /// The options for Klems BSDF XML inputs: the model averaged over each
+    /// sample's patch pairs, `outgoing_samples` view directions per patch
+    /// (`docs/klems.md`), and the lowest roughness Klems data can tell
+    /// ([`crate::klems::MIN_KLEMS_ROUGHNESS`]). The selections are the
+    /// caller's, made with `SelectionOptions::gates(true)`. `brtf fit` and
+    /// the Python package both use it.
+    pub fn for_klems(mut self, outgoing_samples: usize) -> FitSetOptions {
+        self.recipe.patch_average = Some(crate::PatchAveraging {
+            outgoing_samples,
+            ..Default::default()
+        });
+        self.config.min_roughness = crate::klems::MIN_KLEMS_ROUGHNESS;
+        self
+    }
+}
+
 /// What a fit set takes from Klems BSDF XML files.
 #[derive(Debug, Clone, Default)]
 pub struct KlemsOptions {

@@ -68,26 +68,12 @@ fn input_paths(inputs: &Bound<'_, PyAny>) -> PyResult<Vec<PathBuf>> {
     Ok(paths)
 }
 
-/// Klems BSDF XML needs `brtf fit`'s Klems settings (patch averaging,
-/// per side), which this package does not map yet: refused, not fitted
-/// as point samples.
-fn refuse_klems(path: &Path) -> PyResult<()> {
+/// True when `path` starts like XML (a Klems BSDF file).
+fn is_klems(path: &Path) -> bool {
     use std::io::Read;
     let mut head = Vec::with_capacity(4096);
     let opened = std::fs::File::open(path).and_then(|f| f.take(4096).read_to_end(&mut head));
-    if opened.is_ok() && brtf_gonio::is_xml(&head) {
-        return Err(errors::error(
-            Class::Fit,
-            format!(
-                "{}: Klems BSDF XML is fitted with `brtf fit FILE.xml` (per side, patch averages); \
-                 brtf.fit does not fit it yet",
-                path.display()
-            ),
-            Some(path.display().to_string()),
-            None,
-        ));
-    }
-    Ok(())
+    opened.is_ok() && brtf_gonio::is_xml(&head)
 }
 
 /// The keyword arguments of `brtf.fit`, as `brtf fit`'s options.
@@ -115,6 +101,11 @@ pub struct FitKwargs {
     pub free_scale: bool,
     pub interpolation: String,
     pub adequacy: bool,
+    /// Klems XML: the side fitted (`front` or `back`), the incidences kept
+    /// (`theta<=60`, …) and the view directions per outgoing patch.
+    pub side: Option<String>,
+    pub incidences: Option<String>,
+    pub patch_samples: usize,
 }
 
 /// A choice among fixed words, or a `brtf.ModelError` listing them.
@@ -133,8 +124,9 @@ fn choose<T: Copy>(what: &str, value: &str, choices: &[(&str, T)]) -> PyResult<T
 }
 
 impl FitKwargs {
-    /// The library options, mapped exactly as `brtf fit` maps its arguments.
-    fn options(&self, name: String) -> PyResult<FitSetOptions> {
+    /// The library options, mapped exactly as `brtf fit` maps its
+    /// arguments; `klems` for Klems BSDF XML inputs (one side).
+    fn options(&self, name: String, klems: bool) -> PyResult<FitSetOptions> {
         let kind = parse_kind(&self.model)?;
         if self.orientation.iter().all(|c| *c == 0.0) {
             return Err(errors::model(
@@ -160,7 +152,7 @@ impl FitKwargs {
             min_value: self.min_value,
             mask_holder: self.mask_holder,
         }
-        .gates(false);
+        .gates(klems);
         let mut config = FitConfig::new(kind);
         config.options.variant = parse_variant(&self.variant)?;
         config.options.fresnel_k = self.fresnel_k;
@@ -221,7 +213,50 @@ impl FitKwargs {
             )?,
             command_line: vec!["brtf.fit (Python)".into()],
             adequacy: self.adequacy,
-            klems: Default::default(),
+            klems: brtf_fit::KlemsOptions {
+                side: match (klems, self.side.as_deref()) {
+                    (false, None) => None,
+                    (false, Some(_)) => {
+                        return Err(errors::model(
+                            "side= chooses the side of a Klems BSDF XML file",
+                        ));
+                    }
+                    (true, None) => {
+                        return Err(errors::model(
+                            "a Klems BSDF XML file is fitted one side at a time: side=\"front\" or \"back\"",
+                        ));
+                    }
+                    (true, Some(side)) => Some(choose(
+                        "side",
+                        side,
+                        &[
+                            ("front", brtf_gonio::klems::Side::Front),
+                            ("back", brtf_gonio::klems::Side::Back),
+                        ],
+                    )?),
+                },
+                incidences: match (klems, self.incidences.as_deref()) {
+                    (_, None) => None,
+                    (false, Some(_)) => {
+                        return Err(errors::model(
+                            "incidences= selects the incident patches of Klems BSDF XML files",
+                        ));
+                    }
+                    (true, Some(filter)) => Some(
+                        filter
+                            .parse::<brtf_fit::klems::IncidenceFilter>()
+                            .map_err(|e| errors::model(format!("incidences={filter:?}: {e}")))?,
+                    ),
+                },
+            },
+        };
+        if !(1..=4096).contains(&self.patch_samples) {
+            return Err(errors::model("patch_samples must be between 1 and 4096"));
+        }
+        let options = if klems {
+            options.for_klems(self.patch_samples)
+        } else {
+            options
         };
         options
             .validate()
@@ -239,18 +274,39 @@ pub fn run_fit(
     jobs: Option<usize>,
 ) -> PyResult<Fit> {
     let paths = input_paths(inputs)?;
-    for path in &paths {
-        refuse_klems(path)?;
+    let klems = paths.iter().filter(|p| is_klems(p)).count();
+    if klems > 0 && klems < paths.len() {
+        return Err(errors::error(
+            Class::Fit,
+            "Klems BSDF XML files are fitted on their own, not with gonio-photometer files".into(),
+            None,
+            None,
+        ));
     }
+    let klems = klems > 0;
     let name = match &kwargs.name {
         Some(name) => name.clone(),
         None => {
             let mut sample_names = Vec::new();
             for path in &paths {
-                let m = py
-                    .detach(|| brtf_gonio::read_path(path))
-                    .map_err(errors::read)?;
-                sample_names.push(m.sample_name);
+                let name = if klems {
+                    py.detach(|| brtf_gonio::klems::read_path(path))
+                        .map_err(|e| {
+                            errors::error(
+                                Class::Format,
+                                e.to_string(),
+                                Some(path.display().to_string()),
+                                None,
+                            )
+                        })?
+                        .header
+                        .name
+                } else {
+                    py.detach(|| brtf_gonio::read_path(path))
+                        .map_err(errors::read)?
+                        .sample_name
+                };
+                sample_names.push(name);
             }
             let stems: Vec<String> = paths
                 .iter()
@@ -264,7 +320,7 @@ pub fn run_fit(
             brtf_radiance::default_fit_name(&sample_names, &stems)
         }
     };
-    let options = kwargs.options(name)?;
+    let options = kwargs.options(name, klems)?;
     let result = py.detach(|| -> Result<_, String> {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(jobs.unwrap_or(0))

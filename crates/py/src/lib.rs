@@ -21,7 +21,8 @@ use pyo3::prelude::*;
     orientation = [1.0, 0.0, 0.0], floor = None, colour = "xyz", weights = "solid_angle",
     multistart = true, theta_cap = brtf_gonio::DEFAULT_THETA_CAP_DEG, beam_mask = 3.0,
     hemisphere = None, min_value = None, mask_holder = false, beam_integral = None, rho = None,
-    free_scale = false, interpolation = "pchip", adequacy = true, jobs = None))]
+    free_scale = false, interpolation = "pchip", adequacy = true, side = None, incidences = None,
+    patch_samples = 32, jobs = None))]
 #[allow(clippy::too_many_arguments)]
 fn fit_set(
     py: Python<'_>,
@@ -49,6 +50,9 @@ fn fit_set(
     free_scale: bool,
     interpolation: &str,
     adequacy: bool,
+    side: Option<String>,
+    incidences: Option<String>,
+    patch_samples: usize,
     jobs: Option<usize>,
 ) -> PyResult<fit::Fit> {
     let fresnel_k = match fresnel_k {
@@ -79,6 +83,9 @@ fn fit_set(
         free_scale,
         interpolation: interpolation.to_string(),
         adequacy,
+        side,
+        incidences,
+        patch_samples,
     };
     fit::run_fit(py, inputs, kwargs, jobs)
 }

@@ -229,10 +229,6 @@ impl FitArgs {
             mask_holder: self.mask_holder,
         }
         .gates(klems);
-        let patch_average = klems.then(|| brtf_fit::PatchAveraging {
-            outgoing_samples: self.patch_samples,
-            ..Default::default()
-        });
         let mut config = FitConfig::new(model);
         config.options.variant = self.formula.variant;
         config.options.fresnel_k = self.formula.fresnel_k;
@@ -248,10 +244,7 @@ impl FitArgs {
         config.floor = self.floor;
         config.loss = self.loss;
         config.multistart = !self.no_multistart;
-        if klems {
-            config.min_roughness = brtf_fit::klems::MIN_KLEMS_ROUGHNESS;
-        }
-        Ok(FitSetOptions {
+        let options = FitSetOptions {
             name,
             config,
             recipe: Recipe {
@@ -268,7 +261,7 @@ impl FitArgs {
                     WeightsArg::SolidAngle => WeightRule::SolidAngle,
                     WeightsArg::Uniform => WeightRule::Uniform,
                 },
-                patch_average,
+                patch_average: None,
             },
             known_reflectance: self.rho.map(|k| (k.rho, k.theta_in)),
             interpolation: match self.interpolation {
@@ -281,6 +274,11 @@ impl FitArgs {
                 side: None,
                 incidences: self.incidences.clone(),
             },
+        };
+        Ok(if klems {
+            options.for_klems(self.patch_samples)
+        } else {
+            options
         })
     }
 }
