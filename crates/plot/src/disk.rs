@@ -288,32 +288,49 @@ impl Coverage {
             })
         };
         let rim2 = RADIUS * RADIUS;
+        // Bands of rows, each row bounded by the one above it.
+        const BAND: usize = 16;
+        let width = size as usize;
         owner
-            .par_chunks_mut(size as usize)
+            .par_chunks_mut(width * BAND)
             .enumerate()
-            .for_each(|(j, row)| {
-                let y = RADIUS - (j as f64 + 0.5) * pixel;
-                // The previous pixel's nearest point bounds this pixel's
-                // nearest distance: only the cells within that bound are
-                // searched (the exact nearest all the same).
-                let mut previous: Option<usize> = None;
-                for (i, cell) in row.iter_mut().enumerate() {
-                    let x = -RADIUS + (i as f64 + 0.5) * pixel;
-                    if x * x + y * y > rim2 {
-                        continue;
+            .for_each(|(band, rows)| {
+                // Any point's distance bounds a pixel's nearest distance, so
+                // only the cells within that bound are searched (the exact
+                // nearest all the same). The nearest points of the pixel to
+                // the left and of the two above are close to this pixel's,
+                // and the nearest of them gives the bound.
+                let bound_by = |k: u32, x: f64, y: f64| -> f64 {
+                    if k == u32::MAX {
+                        return far;
                     }
-                    let bound = previous.map_or(far, |k| {
-                        let (px, py) = points[k];
-                        let d = ((px - x) * (px - x) + (py - y) * (py - y)).sqrt();
-                        // A hair wider, so that point itself is found again.
-                        (d * (1.0 + 1e-9) + 1e-12).min(far)
-                    });
-                    let nearest = grid.nearest_within(x, y, bound);
-                    previous = nearest.map(|(k, _)| k);
-                    if let Some((k, d)) = nearest.filter(|&(_, d)| d <= far)
-                        && (d <= min_reach || d <= reach_of(k))
-                    {
-                        *cell = ids[k];
+                    let (px, py) = points[k as usize];
+                    let d = ((px - x) * (px - x) + (py - y) * (py - y)).sqrt();
+                    // A hair wider, so that point itself is found again.
+                    (d * (1.0 + 1e-9) + 1e-12).min(far)
+                };
+                // The nearest point of each pixel of the row above (MAX: none).
+                let mut above = vec![u32::MAX; width + 1];
+                for (r, row) in rows.chunks_mut(width).enumerate() {
+                    let j = band * BAND + r;
+                    let y = RADIUS - (j as f64 + 0.5) * pixel;
+                    let mut previous = u32::MAX;
+                    for (i, cell) in row.iter_mut().enumerate() {
+                        let x = -RADIUS + (i as f64 + 0.5) * pixel;
+                        if x * x + y * y > rim2 {
+                            continue;
+                        }
+                        let bound = bound_by(previous, x, y)
+                            .min(bound_by(above[i], x, y))
+                            .min(bound_by(above[i + 1], x, y));
+                        let nearest = grid.nearest_within(x, y, bound);
+                        previous = nearest.map_or(u32::MAX, |(k, _)| k as u32);
+                        above[i] = previous;
+                        if let Some((k, d)) = nearest.filter(|&(_, d)| d <= far)
+                            && (d <= min_reach || d <= reach_of(k))
+                        {
+                            *cell = ids[k];
+                        }
                     }
                 }
             });

@@ -103,9 +103,17 @@ impl Canvas {
                 // the background, so transparent pixels become white.
                 let mut rgb = Vec::with_capacity(raster.rgba.len() / 4 * 3);
                 for px in raster.rgba.chunks_exact(4) {
-                    let a = u32::from(px[3]);
-                    for &c in &px[..3] {
-                        rgb.push(((u32::from(c) * a + 255 * (255 - a) + 127) / 255) as u8);
+                    match px[3] {
+                        // Opaque and transparent pixels (all a map has),
+                        // without the arithmetic: the same bytes.
+                        255 => rgb.extend_from_slice(&px[..3]),
+                        0 => rgb.extend_from_slice(&[255; 3]),
+                        a => {
+                            let a = u32::from(a);
+                            for &c in &px[..3] {
+                                rgb.push(((u32::from(c) * a + 255 * (255 - a) + 127) / 255) as u8);
+                            }
+                        }
                     }
                 }
                 let image = BitMapElement::with_owned_buffer(

@@ -292,48 +292,82 @@ fn build(
     let floor = report.floor;
     let floor2 = floor * floor;
     let incident = m.incident_direction();
-    // Every sample with the model next to it, in parallel; the squared
-    // relative errors of the fitted ones (per channel) are summed
+    // Every sample with the model next to it, in parallel blocks; the
+    // squared relative errors of the fitted ones (per channel) are summed
     // afterwards in sample order.
-    let rows: Vec<(PlotSample, Option<[f64; 3]>)> = m
+    const BLOCK: usize = 4096;
+    let blocks: Vec<Vec<(PlotSample, Option<[f64; 3]>)>> = m
         .samples
-        .par_iter()
-        .zip(removed_by)
+        .par_chunks(BLOCK)
+        .zip(removed_by.par_chunks(BLOCK))
         .enumerate()
-        .with_min_len(4096)
-        .map(|(i, (s, removed))| {
-            let dir = s.direction();
+        .map(|(b, (block, removed))| {
+            let dirs: Vec<DVec3> = block.iter().map(|s| s.direction()).collect();
             // Patch-averaged (Klems) data are compared with the averaged
-            // model; else `model_value` is the BSDF at `dir` (computed once).
-            let f = match prepared.patch_pairs {
-                Some(_) => prepared.model_value(&bsdf, i),
-                None => bsdf.eval(incident, dir),
-            };
-            let mut data = 0.0;
-            let mut model = 0.0;
-            let mut rel = [0.0; 3];
-            for (c, (&y, &fc)) in s.values.iter().zip(&f).take(channels).enumerate() {
-                let mv = report.scale * fc;
-                if removed.is_none() {
-                    let e = mv - y;
-                    rel[c] = e * e / (y * y + floor2);
+            // model ([`PreparedMeasurement::model_value`]); else the model
+            // is the BSDF at each direction, evaluated for the whole block
+            // at once (brtf-model's batch kernel, equal to `Bsdf::eval` to
+            // about 1e-15).
+            let mut values = brtf_model::RgbBatch::default();
+            match prepared.patch_pairs {
+                Some(_) => {
+                    values.resize(0);
+                    for k in 0..block.len() {
+                        let f = prepared.model_value(&bsdf, b * BLOCK + k);
+                        values.r.push(f[0]);
+                        values.g.push(f[1]);
+                        values.b.push(f[2]);
+                    }
                 }
-                data += y;
-                model += mv;
+                None => {
+                    let n = block.len();
+                    let light = brtf_model::Directions {
+                        x: vec![incident.x; n],
+                        y: vec![incident.y; n],
+                        z: vec![incident.z; n],
+                    };
+                    bsdf.eval_batch(
+                        &light,
+                        &brtf_model::Directions::from_vectors(&dirs),
+                        &mut values,
+                    );
+                }
             }
-            let (data, model) = (data / channels as f64, model / channels as f64);
-            let sample = PlotSample {
-                theta: s.theta_deg,
-                phi: s.phi_deg,
-                dir,
-                data,
-                model,
-                removed_by: *removed,
-                log_ratio: log_ratio(data, model, floor),
-            };
-            (sample, removed.is_none().then_some(rel))
+            block
+                .iter()
+                .zip(removed)
+                .zip(dirs)
+                .enumerate()
+                .map(|(k, ((s, removed), dir))| {
+                    let f = values.get(k);
+                    let mut data = 0.0;
+                    let mut model = 0.0;
+                    let mut rel = [0.0; 3];
+                    for (c, (&y, &fc)) in s.values.iter().zip(&f).take(channels).enumerate() {
+                        let mv = report.scale * fc;
+                        if removed.is_none() {
+                            let e = mv - y;
+                            rel[c] = e * e / (y * y + floor2);
+                        }
+                        data += y;
+                        model += mv;
+                    }
+                    let (data, model) = (data / channels as f64, model / channels as f64);
+                    let sample = PlotSample {
+                        theta: s.theta_deg,
+                        phi: s.phi_deg,
+                        dir,
+                        data,
+                        model,
+                        removed_by: *removed,
+                        log_ratio: log_ratio(data, model, floor),
+                    };
+                    (sample, removed.is_none().then_some(rel))
+                })
+                .collect()
         })
         .collect();
+    let rows = blocks.into_iter().flatten();
     let mut sum_rel = 0.0;
     let mut n_used = 0usize;
     let samples: Vec<PlotSample> = rows
