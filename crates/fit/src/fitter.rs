@@ -142,6 +142,11 @@ fn fit_many(
     // Every incidence of an all-incidence fit keeps a few samples in the
     // starts' subsample, else its cost says little about the whole.
     let start_samples = START_SAMPLES.max(START_SAMPLES_PER_INCIDENCE * n_blocks);
+    let start_stage = if data.len() > 1 {
+        Stage::START_ALL_INCIDENCES
+    } else {
+        Stage::START
+    };
     let share = move |count: usize| count / n_blocks;
     let ((floor, starts), bright) = rayon::join(
         || {
@@ -194,7 +199,7 @@ fn fit_many(
         // choice deterministic.
         let solved: Vec<Solved> = starts
             .par_iter()
-            .map(|(_, u0)| solver.solve(&sub, u0.clone(), Stage::START))
+            .map(|(_, u0)| solver.solve(&sub, u0.clone(), start_stage))
             .collect();
         for ((rough, _), end) in starts.iter().zip(&solved) {
             evaluations += end.evaluations;
@@ -217,6 +222,7 @@ fn fit_many(
             &blocks,
             &mut ends,
             polish.then(|| thin(POLISH_SAMPLES)),
+            start_stage,
             &mut evaluations,
         );
         for (&i, cost) in order.iter().zip(&full_costs) {
@@ -232,11 +238,18 @@ fn fit_many(
             &blocks,
             &mut ends,
             Some(thin(POLISH_SAMPLES)),
+            start_stage,
             &mut evaluations,
         );
     }
     let u_start = ends.swap_remove(0);
-    let mut solved = solver.solve_final(&blocks, u_start);
+    // Over many incidences Gauss-Newton can converge linearly (a model
+    // that cannot follow every incidence): extrapolated rounds there.
+    let mut solved = if data.len() > 1 {
+        solver.solve_final(&blocks, u_start)
+    } else {
+        solver.solve(&blocks, u_start, Stage::FINAL)
+    };
     evaluations += solved.evaluations;
     if !solved.cost.is_finite() {
         return Err(FitError::Failed {
@@ -347,12 +360,13 @@ fn candidates_full_costs(
     blocks: &[Block<'_>],
     candidates: &mut [DVector<f64>],
     polish: Option<Vec<Block<'_>>>,
+    stage: Stage,
     evaluations: &mut usize,
 ) -> Vec<f64> {
     if let Some(sub) = &polish {
         let polished: Vec<Solved> = candidates
             .par_iter()
-            .map(|u| solver.solve(sub, u.clone(), Stage::START))
+            .map(|u| solver.solve(sub, u.clone(), stage))
             .collect();
         for (u, p) in candidates.iter_mut().zip(polished) {
             *evaluations += p.evaluations;
