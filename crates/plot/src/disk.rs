@@ -145,14 +145,17 @@ impl Grid {
     }
 
     /// Nearest point to (x, y) no farther than `r` (ties: the lower index),
-    /// found among the cells that meet the square of half-side `r`.
-    fn nearest_within(&self, x: f64, y: f64, r: f64) -> Option<(usize, f64)> {
+    /// found among the cells that meet the square of half-side `r`. When
+    /// `occupied`, the caller knows a point within `r` (so the test for an
+    /// empty square is skipped).
+    fn nearest_within(&self, x: f64, y: f64, r: f64, occupied: bool) -> Option<(usize, f64)> {
         let n = self.n as isize;
-        let cell_index =
-            |v: f64| (((v + RADIUS) / self.cell).floor() as isize).clamp(0, n - 1) as usize;
+        // Truncation, not `floor` (a libm call here): they differ only
+        // below 0, which is clamped to 0 either way.
+        let cell_index = |v: f64| (((v + RADIUS) / self.cell) as isize).clamp(0, n - 1) as usize;
         let (x0, x1) = (cell_index(x - r), cell_index(x + r));
         let (y0, y1) = (cell_index(y - r), cell_index(y + r));
-        if self.count((x0, x1), (y0, y1)) == 0 {
+        if !occupied && self.count((x0, x1), (y0, y1)) == 0 {
             return None;
         }
         let r2 = r * r;
@@ -323,7 +326,8 @@ impl Coverage {
                         let bound = bound_by(previous, x, y)
                             .min(bound_by(above[i], x, y))
                             .min(bound_by(above[i + 1], x, y));
-                        let nearest = grid.nearest_within(x, y, bound);
+                        // Below `far`, the bound is a point's distance.
+                        let nearest = grid.nearest_within(x, y, bound, bound < far);
                         previous = nearest.map_or(u32::MAX, |(k, _)| k as u32);
                         above[i] = previous;
                         if let Some((k, d)) = nearest.filter(|&(_, d)| d <= far)
