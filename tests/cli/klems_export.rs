@@ -572,6 +572,17 @@ fn anisotropic_fit_exports_the_parameters_of_each_azimuth() {
         .map(|r| r["phi_in"].as_array().unwrap().len())
         .collect();
     assert_eq!(counts, [1, 8, 16, 20, 24], "the Klems rings to 40°");
+    // The plots show the parameters over φ_in, a line per ring.
+    brtf(&["plot", s(&fit_dir)], "").ok();
+    let phi_chart = std::fs::read_to_string(fit_dir.join("plots/params-phi.svg")).unwrap();
+    for ring in ["θ_in 0°", "θ_in 10°", "θ_in 40°"] {
+        assert!(phi_chart.contains(ring), "{ring} missing");
+    }
+    let report = std::fs::read_to_string(fit_dir.join("report.html")).unwrap();
+    assert!(
+        report.contains("params-phi"),
+        "the report shows the φ_in chart"
+    );
     // At each fitted incidence the table gives that incidence's own fit.
     let result = brtf_fit::FitResult::read(&fit_dir).unwrap();
     for r in &result.incidences {

@@ -353,6 +353,8 @@ fn real_fabric_both_sides_converge_and_are_reported_side_by_side() {
     );
     // Two rings per side, reflection and transmission disks each.
     assert_eq!(report.matches("<figure><svg").count(), 8);
+    // An isotropic type's table does not follow φ_in: no φ_in chart.
+    assert!(!out.join("front/plots/params-phi.svg").exists());
     assert!(!report.contains("cannot be shown"), "{report}");
 }
 

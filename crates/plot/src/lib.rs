@@ -51,6 +51,7 @@ pub use klems::klems_sides_report;
 
 use brtf_fit::{FitResult, PreparedMeasurement};
 use brtf_gonio::Hemisphere;
+use charts::azimuth::AzimuthChart;
 use charts::cut::{CutChart, CutsChart};
 use charts::map::MapChart;
 use charts::theta::{ParamsChart, RhoChart, RmsChart};
@@ -139,6 +140,7 @@ enum Job<'a> {
     Cut(CutChart<'a>),
     Cuts(CutsChart<'a>),
     Params(ParamsChart<'a>),
+    Azimuth(AzimuthChart<'a>),
     Rho(RhoChart<'a>),
     Rms(RmsChart<'a>),
 }
@@ -150,6 +152,7 @@ impl Job<'_> {
             Job::Cut(c) => render_files(c, dir),
             Job::Cuts(c) => render_files(c, dir),
             Job::Params(c) => render_files(c, dir),
+            Job::Azimuth(c) => render_files(c, dir),
             Job::Rho(c) => render_files(c, dir),
             Job::Rms(c) => render_files(c, dir),
         }
@@ -358,6 +361,23 @@ fn plot(
         ),
     ];
     jobs.push(Job::Params(params));
+    if AzimuthChart::applies(result) {
+        let azimuth = AzimuthChart {
+            result,
+            title: format!("{name} ({model}): fitted parameters over φ_in, one line per θ_in ring"),
+        };
+        overview.insert(
+            1,
+            (
+                azimuth.name(),
+                azimuth.size(),
+                "The parameters follow φ_in too: each θ_in ring's incidences (dots) and the linear, \
+                 periodic interpolation between them that the exports use (lines)."
+                    .to_string(),
+            ),
+        );
+        jobs.push(Job::Azimuth(azimuth));
+    }
     jobs.push(Job::Rho(rho));
     jobs.push(Job::Rms(rms));
     if !incs.is_empty() {

@@ -3,7 +3,10 @@
 //! * [`map`]: per incidence, model ÷ data over the hemisphere.
 //! * [`cut`]: per incidence, the in-plane cut; and all cuts in one chart.
 //! * [`theta`]: over θ_in, the parameters, ρ_dh and the RMS error.
+//! * [`azimuth`]: over φ_in, the parameters of each θ_in ring, for tables
+//!   that follow φ_in (anisotropic types fitted to Klems XML).
 
+pub mod azimuth;
 pub mod cut;
 pub mod map;
 pub mod theta;
