@@ -470,7 +470,31 @@ fn eval_lane<const ANISO: bool, const TRANS: bool, const V: u8, const FRESNEL: b
 
 /// `1.5 · 2⁵²`: adding it rounds a double of magnitude < 2⁵¹ to an integer
 /// and leaves that integer in the low bits of the representation.
-const ROUND_MAGIC: f64 = 6_755_399_441_055_744.0;
+pub(crate) const ROUND_MAGIC: f64 = 6_755_399_441_055_744.0;
+/// ln 2 = `EXP_LN2_HI + EXP_LN2_LO`, the high part with 21 trailing zero
+/// bits so that n·`EXP_LN2_HI` is exact (fdlibm's split). Shared by
+/// [`exp_lane`] and the SIMD `exp` of the gradient kernel, which must give
+/// the same bits.
+pub(crate) const EXP_LN2_HI: f64 = f64::from_bits(0x3fe6_2e42_fee0_0000);
+pub(crate) const EXP_LN2_LO: f64 = f64::from_bits(0x3dea_39ef_3579_3c76);
+/// Below this, `eˣ` < 3.3e-308: flushed to 0.
+pub(crate) const EXP_FLUSH_BELOW: f64 = -708.0;
+/// Taylor coefficients 1/k!, k = 0 to 12, of `eʳ`.
+pub(crate) const EXP_TAYLOR: [f64; 13] = [
+    1.0,
+    1.0,
+    0.5,
+    1.0 / 6.0,
+    1.0 / 24.0,
+    1.0 / 120.0,
+    1.0 / 720.0,
+    1.0 / 5_040.0,
+    1.0 / 40_320.0,
+    1.0 / 362_880.0,
+    1.0 / 3_628_800.0,
+    1.0 / 39_916_800.0,
+    1.0 / 479_001_600.0,
+];
 
 /// `2ⁿ` for an integer-valued `n` in [−1022, 1023], from the bits.
 #[inline(always)]
@@ -488,28 +512,10 @@ fn pow2(n: f64) -> f64 {
 /// per lane). NaN stays NaN.
 #[inline(always)]
 pub fn exp_lane(x: f64) -> f64 {
-    // ln 2 = LN2_HI + LN2_LO, LN2_HI with 21 trailing zero bits so that
-    // n·LN2_HI is exact (fdlibm's split).
-    const LN2_HI: f64 = f64::from_bits(0x3fe6_2e42_fee0_0000);
-    const LN2_LO: f64 = f64::from_bits(0x3dea_39ef_3579_3c76);
-    /// Below this, `eˣ` < 3.3e-308: flushed to 0.
-    const FLUSH_BELOW: f64 = -708.0;
-    // Taylor coefficients 1/k!, k = 0 to 12.
-    const A: [f64; 13] = [
-        1.0,
-        1.0,
-        0.5,
-        1.0 / 6.0,
-        1.0 / 24.0,
-        1.0 / 120.0,
-        1.0 / 720.0,
-        1.0 / 5_040.0,
-        1.0 / 40_320.0,
-        1.0 / 362_880.0,
-        1.0 / 3_628_800.0,
-        1.0 / 39_916_800.0,
-        1.0 / 479_001_600.0,
-    ];
+    const LN2_HI: f64 = EXP_LN2_HI;
+    const LN2_LO: f64 = EXP_LN2_LO;
+    const FLUSH_BELOW: f64 = EXP_FLUSH_BELOW;
+    const A: [f64; 13] = EXP_TAYLOR;
     // Clamped so that 2ⁿ stays representable; the comparisons keep NaN.
     let xc = x.clamp(FLUSH_BELOW, 709.0);
     let n = (xc * std::f64::consts::LOG2_E + ROUND_MAGIC) - ROUND_MAGIC;

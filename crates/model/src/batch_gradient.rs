@@ -29,7 +29,10 @@
 
 #![allow(clippy::needless_range_loop)] // channel and lane loops index several arrays at once
 
-use crate::batch::{Constants, MANUAL2004, RADIANCE, WARD1992};
+use crate::batch::{
+    Constants, EXP_FLUSH_BELOW, EXP_LN2_HI, EXP_LN2_LO, EXP_TAYLOR, MANUAL2004, RADIANCE,
+    ROUND_MAGIC, WARD1992,
+};
 use crate::bsdf::{Bsdf, Geometry, Gradient, Rgb};
 use crate::kind::Variant;
 use crate::material::FTINY;
@@ -484,26 +487,10 @@ impl<S: pulp::Simd> Ops<S> {
     /// values, bit for bit).
     #[inline(always)]
     fn exp(self, x: S::f64s) -> S::f64s {
-        const LN2_HI: f64 = f64::from_bits(0x3fe6_2e42_fee0_0000);
-        const LN2_LO: f64 = f64::from_bits(0x3dea_39ef_3579_3c76);
-        const FLUSH_BELOW: f64 = -708.0;
-        const ROUND_MAGIC: f64 = 6_755_399_441_055_744.0;
-        // Taylor coefficients 1/k!, k = 0 to 12.
-        const A: [f64; 13] = [
-            1.0,
-            1.0,
-            0.5,
-            1.0 / 6.0,
-            1.0 / 24.0,
-            1.0 / 120.0,
-            1.0 / 720.0,
-            1.0 / 5_040.0,
-            1.0 / 40_320.0,
-            1.0 / 362_880.0,
-            1.0 / 3_628_800.0,
-            1.0 / 39_916_800.0,
-            1.0 / 479_001_600.0,
-        ];
+        const LN2_HI: f64 = EXP_LN2_HI;
+        const LN2_LO: f64 = EXP_LN2_LO;
+        const FLUSH_BELOW: f64 = EXP_FLUSH_BELOW;
+        const A: [f64; 13] = EXP_TAYLOR;
         let a = |k: usize| self.splat(A[k]);
         let s = self.0;
         // Clamped so that 2ⁿ stays representable (max then min, as
