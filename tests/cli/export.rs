@@ -399,6 +399,17 @@ impl Stats {
     }
 }
 
+/// The fit's formulas as rtrace applies them to the test scene's light: a
+/// source of solid angle `omega` on a flat surface, no jitter.
+fn as_rtrace_lights(result: &FitResult, omega: f64) -> EvalOptions {
+    EvalOptions {
+        source_omega: omega,
+        flat: true,
+        source_jitter: 0.0,
+        ..result.config.options
+    }
+}
+
 /// View directions (θ_out, φ_out): a grid over both hemispheres and a
 /// dense patch around the mirror and straight-through directions.
 fn views(theta_in: f64, phi_in: f64) -> Vec<(f64, f64)> {
@@ -760,13 +771,7 @@ fn theta_export_matches_live_rtrace() {
         |k, t, p, v, f| {
             let result = &cases[k].1;
             let table = result.table.as_ref().unwrap();
-            let options = EvalOptions {
-                variant: result.config.options.variant,
-                fresnel_k: result.config.options.fresnel_k,
-                source_omega: omega,
-                flat: true,
-                source_jitter: 0.0,
-            };
+            let options = as_rtrace_lights(result, omega);
             let material = table.at(t).unwrap().material;
             let model = Bsdf::new(&material, &options).eval(direction(t, p), v);
             for c in 0..3 {
@@ -888,13 +893,7 @@ fn azimuth_export_matches_live_rtrace() {
         omega,
         |k, t, p, v, f| {
             let table = cases[k].1.table.as_ref().unwrap();
-            let options = EvalOptions {
-                variant: Variant::Radiance,
-                fresnel_k: cases[k].1.config.options.fresnel_k,
-                source_omega: omega,
-                flat: true,
-                source_jitter: 0.0,
-            };
+            let options = as_rtrace_lights(&cases[k].1, omega);
             let l = direction(t, p);
             let material = table.at_direction(t, p - 30.0).unwrap().material;
             let model = Bsdf::new(&material, &options).eval(l, v);

@@ -95,11 +95,12 @@ impl Solver<'_> {
         self.solve_seeded(blocks, u0, stage, Vec::new()).0
     }
 
-    /// The fit on every sample, in rounds of [`ROUND_PATIENCE`]: when a
-    /// round ends on its budget with its last steps in one direction,
-    /// each shorter than the one before by a steady ratio, the rest of
-    /// that geometric series is taken in one step (kept only if it lowers
-    /// the cost), and the next round starts there.
+    /// The all-incidence fit on every sample, in rounds of
+    /// [`ROUND_PATIENCE`]: when a round ends on its budget, [`extrapolate`]
+    /// estimates the limit its accepted points are heading for; the next
+    /// round starts there if that lowers the cost. Without a gain, or after
+    /// [`MAX_JUMPS`], the fit finishes in one run with the rest of the
+    /// budget, keeping LM's damping.
     ///
     /// Gauss-Newton converges only linearly where the model cannot fit the
     /// data (a large residual): on a Klems fabric's all-incidence fit each
@@ -114,60 +115,46 @@ impl Solver<'_> {
             ..stage
         };
         let mut spent = 0;
-        let mut jumps = 0;
         let mut start = u0;
         let mut seed = Vec::new();
-        loop {
-            // After the last jump the fit finishes in one run.
-            let this_round = if jumps < MAX_JUMPS {
-                round
-            } else {
-                Stage {
-                    patience: budget
-                        .saturating_sub(spent)
-                        .div_ceil(self.map.len() + 1)
-                        .max(1),
-                    ..stage
-                }
-            };
-            let (mut solved, accepted) = self.solve_seeded(blocks, start, this_round, seed);
+        for _ in 0..MAX_JUMPS {
+            let (mut solved, accepted) = self.solve_seeded(blocks, start, round, seed);
             spent += solved.evaluations;
-            let out_of_round =
-                jumps < MAX_JUMPS && matches!(solved.termination, TerminationReason::LostPatience);
+            let out_of_round = matches!(solved.termination, TerminationReason::LostPatience);
             let Some(at_solution) = solved.at_solution.clone().filter(|_| out_of_round) else {
                 solved.evaluations = spent;
                 return solved;
             };
-            let jump = extrapolate(&accepted).and_then(|jump| {
+            // Where the round ended, or the extrapolated limit if lower.
+            let mut next = (solved.u.clone(), at_solution);
+            let mut jumped = false;
+            if let Some(jump) = extrapolate(&accepted) {
                 let mut problem = self.problem(blocks);
                 problem.report = stage.report;
-                let c = problem.evaluated(&jump)?;
-                spent += problem.evaluations.get();
-                (0.5 * c.residuals.norm_squared() < solved.cost).then_some((jump, c))
-            });
-            match jump {
-                Some((u, c)) if spent < budget => {
-                    jumps += 1;
-                    start = u.clone();
-                    seed = vec![(u, c)];
-                }
-                // Nothing to gain from another restart (LM would lose its
-                // damping again): finish with the rest of the budget.
-                _ => {
-                    let (u, c) = jump.unwrap_or((solved.u.clone(), at_solution));
-                    let rest = Stage {
-                        patience: budget
-                            .saturating_sub(spent)
-                            .div_ceil(self.map.len() + 1)
-                            .max(1),
-                        ..stage
-                    };
-                    let (mut last, _) = self.solve_seeded(blocks, u.clone(), rest, vec![(u, c)]);
-                    last.evaluations += spent;
-                    return last;
+                if let Some(c) = problem.evaluated(&jump) {
+                    spent += problem.evaluations.get();
+                    if 0.5 * c.residuals.norm_squared() < solved.cost {
+                        next = (jump, c);
+                        jumped = true;
+                    }
                 }
             }
+            start = next.0.clone();
+            seed = vec![next];
+            if !jumped || spent >= budget {
+                break;
+            }
         }
+        let rest = Stage {
+            patience: budget
+                .saturating_sub(spent)
+                .div_ceil(self.map.len() + 1)
+                .max(1),
+            ..stage
+        };
+        let (mut last, _) = self.solve_seeded(blocks, start, rest, seed);
+        last.evaluations += spent;
+        last
     }
 
     /// Runs Levenberg-Marquardt from `u0`, whose pass may be in `seed`;
