@@ -39,6 +39,13 @@ pub struct InputFile {
 }
 
 impl InputFile {
+    /// True for an incident patch of a Klems file's back side, whose data
+    /// are described in a mirrored frame ([`crate::azimuth_from_u`]).
+    pub fn is_klems_back_side(&self) -> bool {
+        self.klems
+            .is_some_and(|k| k.side == brtf_gonio::klems::Side::Back)
+    }
+
     /// The name its incidence's report carries as `source`: the path, or
     /// for a Klems patch `path [front patch 12]`.
     pub fn label(&self) -> String {
@@ -310,10 +317,10 @@ impl FitResult {
     /// True when the fitted data are the back side of a Klems file, whose
     /// frame is mirrored ([`crate::azimuth_from_u`]).
     pub fn is_mirrored_side(&self) -> bool {
-        self.provenance.inputs.iter().any(|i| {
-            i.klems
-                .is_some_and(|k| k.side == brtf_gonio::klems::Side::Back)
-        })
+        self.provenance
+            .inputs
+            .iter()
+            .any(InputFile::is_klems_back_side)
     }
 
     /// The material at θ_in: the table's, else the incidence's own fit

@@ -257,11 +257,7 @@ pub fn fit_set_with_data(
         ParamTable::from_reports(kind, orientation, &reports, method)
     } else if kind.is_anisotropic() {
         // The back side's frame is mirrored.
-        let mirrored = inputs.iter().any(|i| {
-            i.file
-                .klems
-                .is_some_and(|k| k.side == brtf_gonio::klems::Side::Back)
-        });
+        let mirrored = inputs.iter().any(|i| i.file.is_klems_back_side());
         ParamTable::from_reports_over_azimuth(kind, orientation, &reports, method, mirrored)
     } else {
         ParamTable::from_reports_phi_averaged(kind, orientation, &reports, method)
