@@ -118,20 +118,20 @@ fn fit_many(
     let gray = config.gray || channels == 1;
     let map = ParamMap::new(config.kind, gray, config.free_scale)
         .with_min_roughness(config.min_roughness);
+    // Patch-averaged blocks get their pairs' geometry once per fit (or
+    // the fit set's shared one), unless it would take too much memory.
+    let own_geometry = match geometry {
+        Some(_) => None,
+        None => shared_pair_geometry(data, config)?,
+    };
+    let geometry = geometry.or(own_geometry.as_deref());
     let mut blocks = Vec::with_capacity(data.len());
     let mut stats = Vec::with_capacity(data.len());
-    for d in data {
-        let scan = prepare::scan(d, channels, config)?;
+    for (k, d) in data.iter().enumerate() {
+        let mut scan = prepare::scan(d, channels, config)?;
+        scan.block.pair_geometry = geometry.map(|g| Cow::Borrowed(&g[k]));
         blocks.push(scan.block);
         stats.push(scan.stats);
-    }
-    match geometry {
-        Some(shared) => {
-            for (b, g) in blocks.iter_mut().zip(shared) {
-                b.pair_geometry = Some(Cow::Borrowed(g));
-            }
-        }
-        None => attach_pair_geometry(&mut blocks, config)?,
     }
     let n_points: usize = blocks.iter().map(Block::len).sum();
     // Large enough to polish the best start on a subsample first.
@@ -314,26 +314,6 @@ fn fit_many(
         started,
     };
     report.build(&solver, &blocks, solved)
-}
-
-/// Patch-averaged blocks get their pairs' geometry computed once, unless
-/// it would take more memory than [`GEOMETRY_CACHE_PAIRS`] pairs' worth.
-fn attach_pair_geometry(blocks: &mut [Block<'_>], config: &FitConfig) -> Result<(), FitError> {
-    let pairs: usize = blocks
-        .iter()
-        .filter_map(|b| b.pairs.as_ref())
-        .map(|p| p.pair_count())
-        .sum();
-    if pairs == 0 || pairs > GEOMETRY_CACHE_PAIRS {
-        return Ok(());
-    }
-    let bsdf = geometry_bsdf(config)?;
-    blocks.par_iter_mut().for_each(|b| {
-        if let Some(p) = &b.pairs {
-            b.pair_geometry = Some(Cow::Owned(PairGeometry::new(p, &bsdf)));
-        }
-    });
-    Ok(())
 }
 
 /// A BSDF of the fit's type, orientation and options, for pair geometry:
