@@ -4,7 +4,7 @@
 //! and the report with its standard errors.
 
 use crate::config::{FitConfig, FitError, RobustLoss};
-use crate::data::{IncidenceData, PatchPairs};
+use crate::data::{FitSample, IncidenceData, PatchPairs};
 use crate::pair_geometry::PairGeometry;
 use crate::params::{ParamMap, Target};
 use crate::prepare;
@@ -15,7 +15,7 @@ use crate::report::{
 use crate::robust;
 use crate::solve::{Solved, Solver, Stage};
 use crate::uncertainty::standard_errors;
-use brtf_model::{Bsdf, Material};
+use brtf_model::{Bsdf, Geometry, GeometryBatch, Material};
 use glam::DVec3;
 use nalgebra::DVector;
 use rayon::prelude::*;
@@ -127,9 +127,19 @@ fn fit_many(
     let geometry = geometry.or(own_geometry.as_deref());
     let mut blocks = Vec::with_capacity(data.len());
     let mut stats = Vec::with_capacity(data.len());
+    // Measured samples get their geometry once per fit.
+    let sample_bsdf = if data.iter().any(|d| d.patch_pairs.is_none()) {
+        Some(geometry_bsdf(config)?)
+    } else {
+        None
+    };
     for (k, d) in data.iter().enumerate() {
         let mut scan = prepare::scan(d, channels, config)?;
         scan.block.pair_geometry = geometry.map(|g| Cow::Borrowed(&g[k]));
+        if let (None, Some(bsdf)) = (&scan.block.pairs, &sample_bsdf) {
+            let geometry = sample_geometry(bsdf, scan.block.light, &scan.block.samples);
+            scan.block.sample_geometry = Some(Cow::Owned(geometry));
+        }
         blocks.push(scan.block);
         stats.push(scan.stats);
     }
@@ -314,6 +324,21 @@ fn fit_many(
         started,
     };
     report.build(&solver, &blocks, solved)
+}
+
+/// The geometry of every sample seen from `light` (in parallel pieces for
+/// many samples; each entry depends on its own sample only).
+fn sample_geometry(bsdf: &Bsdf, light: DVec3, samples: &[FitSample]) -> GeometryBatch {
+    const PIECE: usize = 16_384;
+    let piece = |s: &[FitSample]| -> Vec<Geometry> {
+        s.iter().map(|s| bsdf.geometry(light, s.view)).collect()
+    };
+    let pieces: Vec<Vec<Geometry>> = if samples.len() > PIECE {
+        samples.par_chunks(PIECE).map(piece).collect()
+    } else {
+        vec![piece(samples)]
+    };
+    pieces.into_iter().flatten().collect()
 }
 
 /// A BSDF of the fit's type, orientation and options, for pair geometry:

@@ -34,6 +34,7 @@ mod data;
 mod diagnose;
 pub mod en14501;
 mod fitter;
+mod gram;
 pub mod klems;
 mod pair_geometry;
 mod params;

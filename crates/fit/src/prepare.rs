@@ -175,6 +175,7 @@ pub(crate) fn scan<'a>(
             samples: Cow::Borrowed(&d.samples),
             pairs: d.patch_pairs.as_deref().map(Cow::Borrowed),
             pair_geometry: None,
+            sample_geometry: None,
             weight_scale: if unit_weights {
                 1.0
             } else {
@@ -183,6 +184,7 @@ pub(crate) fn scan<'a>(
             unit_weights,
             multipliers: None,
             factors: Vec::new(),
+            log_values: Vec::new(),
             channels,
         },
         stats: ScanStats {
@@ -231,6 +233,7 @@ pub(crate) fn subsample<'a>(b: &Block<'_>, target: usize, bright: f64) -> Block<
     let mut kept = Vec::new();
     let mut multipliers = Vec::new();
     let mut factors = Vec::new();
+    let mut log_values = Vec::new();
     let expand = (step as f64).sqrt();
     for (i, s) in b.samples.iter().enumerate() {
         let mean = channel_mean(s, channels);
@@ -249,6 +252,9 @@ pub(crate) fn subsample<'a>(b: &Block<'_>, target: usize, bright: f64) -> Block<
                 .iter()
                 .map(|k| k * m),
         );
+        if !b.log_values.is_empty() {
+            log_values.extend_from_slice(&b.log_values[i * channels..(i + 1) * channels]);
+        }
     }
     Block {
         light: b.light,
@@ -261,10 +267,15 @@ pub(crate) fn subsample<'a>(b: &Block<'_>, target: usize, bright: f64) -> Block<
             .pair_geometry
             .as_ref()
             .map(|g| Cow::Owned(g.select(kept.iter().copied()))),
+        sample_geometry: b
+            .sample_geometry
+            .as_ref()
+            .map(|g| Cow::Owned(kept.iter().map(|&i| g.get(i)).collect())),
         weight_scale: b.weight_scale,
         unit_weights: b.unit_weights,
         multipliers: Some(multipliers),
         factors,
+        log_values,
         channels,
     }
 }

@@ -3,9 +3,10 @@
 //! in the unconstrained coordinates of [`ParamMap`].
 
 use crate::data::{FitSample, PatchPairs};
+use crate::gram::{self, RunColumns};
 use crate::pair_geometry::PairGeometry;
 use crate::params::{ParamMap, Target};
-use brtf_model::{Bsdf, EvalOptions, GeometryBatch, Gradient, Material};
+use brtf_model::{Bsdf, EvalOptions, GeometryBatch, Gradient, Material, PairTerms};
 use glam::DVec3;
 use levenberg_marquardt::LeastSquaresProblem;
 use nalgebra::{DMatrix, DVector, Dyn, Owned};
@@ -37,10 +38,7 @@ pub enum ResidualKind {
 pub(crate) struct Block<'a> {
     /// Unit vector towards the light.
     pub light: DVec3,
-    /// The samples, borrowed from the caller (owned for a subsample). The
-    /// argument-free part of the BSDF ([`brtf_model::Geometry`]) is recomputed from
-    /// them on every pass: that costs a few operations per sample, while
-    /// storing it would cost as much memory traffic as reading the samples.
+    /// The samples, borrowed from the caller (owned for a subsample).
     pub samples: Cow<'a, [FitSample]>,
     /// Patch-averaged data: the (light, view) pairs each sample's model
     /// value is averaged over (then `light` and the samples' views are
@@ -49,6 +47,10 @@ pub(crate) struct Block<'a> {
     /// The pairs' geometry, computed once (see [`PairGeometry`]); without
     /// it the kernel computes it from `pairs` on every pass.
     pub pair_geometry: Option<Cow<'a, PairGeometry>>,
+    /// Measured samples: each sample's (light, view) geometry, computed
+    /// once per fit (it does not depend on the arguments); without it the
+    /// kernel computes it on every pass.
+    pub sample_geometry: Option<Cow<'a, GeometryBatch>>,
     /// √(weight) of sample i is `√max(wᵢ, 0) · weight_scale` (or
     /// `weight_scale` alone with `unit_weights`), times `multipliers[i]`
     /// when a robust loss has reweighted the samples or a subsample stands
@@ -59,6 +61,9 @@ pub(crate) struct Block<'a> {
     /// Per value (sample × channel), the factor turning `m − y` into a
     /// residual.
     pub factors: Vec<f64>,
+    /// Per value, `ln(max(y, 0) + floor)` for [`ResidualKind::Log`] (empty
+    /// for the other kinds): the data's side of every log residual.
+    pub log_values: Vec<f64>,
     pub channels: usize,
 }
 
@@ -104,6 +109,28 @@ impl Block<'_> {
                 .for_each(fill);
         }
         self.factors = factors;
+        self.log_values = if kind == ResidualKind::Log {
+            let log = |s: &FitSample| -> Vec<f64> {
+                s.value[..channels]
+                    .iter()
+                    .map(|&y| (y.max(0.0) + floor).ln())
+                    .collect()
+            };
+            if self.samples.len() >= PARALLEL_ROWS {
+                self.samples.par_iter().flat_map_iter(log).collect()
+            } else {
+                self.samples.iter().flat_map(log).collect()
+            }
+        } else {
+            Vec::new()
+        };
+    }
+
+    /// The data's log of value `row` (see `log_values`), or NaN for
+    /// the other residual kinds, which do not use it.
+    #[inline(always)]
+    fn log_value(&self, row: usize) -> f64 {
+        self.log_values.get(row).copied().unwrap_or(f64::NAN)
     }
 
     /// √(weight) of sample `i`.
@@ -350,19 +377,29 @@ impl Kernel<'_> {
         let channels = self.channels;
         let mut data = Vec::with_capacity((end - start) * channels);
         let mut sum_rel = 0.0;
-        let mut scratch = GeometryBatch::new();
-        for i in start..end {
+        let mut add = |i: usize, f: [f64; 3]| {
             let s = &block.samples[i];
-            let f = if block.pairs.is_some() {
-                self.average(block, i, &mut scratch)
-            } else {
-                self.bsdf.eval(block.light, s.view)
-            };
             for ch in 0..channels {
                 let row = i * channels + ch;
-                let (res, _, rel2) = self.residual(f[ch], s.value[ch], block.factors[row]);
+                let (res, _, rel2) =
+                    self.residual(f[ch], s.value[ch], block.factors[row], block.log_value(row));
                 data.push(res);
                 sum_rel += rel2;
+            }
+        };
+        if block.pairs.is_some() {
+            let mut scratch = GeometryBatch::new();
+            for i in start..end {
+                add(i, self.average(block, i, &mut scratch));
+            }
+        } else {
+            let mut run = Run::new();
+            for first in (start..end).step_by(RUN) {
+                let last = (first + RUN).min(end);
+                run.evaluate::<false>(self, block, first..last);
+                for i in first..last {
+                    add(i, run.value(i - first));
+                }
             }
         }
         ChunkResult {
@@ -377,73 +414,154 @@ impl Kernel<'_> {
     /// unroll the accumulation.
     fn gram<const W: usize, const REPORT: bool>(&self, (b, start, end): Chunk) -> ChunkResult {
         let block = &self.blocks[b];
+        let mut sums = GramSums::<W>::new();
+        if block.pairs.is_some() {
+            let mut grad = Gradient::default();
+            let mut scratch = GeometryBatch::new();
+            for i in start..end {
+                let f = self.average_with_gradient(block, i, &mut grad, &mut scratch);
+                self.add_rows::<W, REPORT>(&mut sums, block, i, f, |a, ch| grad.d[a][ch]);
+            }
+        } else {
+            // Samples in short runs: the model through brtf-model's
+            // vectorised per-pair kernel, the rows into columns, the
+            // columns' products summed with SIMD vectors.
+            let mut run = Run::new();
+            let mut columns = RunColumns::default();
+            let mut dr_dm = Vec::with_capacity(RUN * self.channels);
+            for first in (start..end).step_by(RUN) {
+                let last = (first + RUN).min(end);
+                run.evaluate::<true>(self, block, first..last);
+                self.put_columns::<W, REPORT>(
+                    &run.terms,
+                    block,
+                    first,
+                    &mut columns,
+                    &mut dr_dm,
+                    &mut sums,
+                );
+                gram::accumulate::<W, REPORT>(&columns, &mut sums.gram, &mut sums.meat);
+            }
+        }
+        let mut data: Vec<f64> = sums.gram.iter().flatten().copied().collect();
+        if REPORT {
+            data.extend(sums.meat.iter().flatten());
+        }
+        ChunkResult {
+            finite: data.iter().all(|v| v.is_finite()),
+            data,
+            sum_rel: sums.sum_rel,
+        }
+    }
+
+    /// Writes the rows of the run of `block`'s samples from `first` (one
+    /// per sample and channel; the run's model terms `terms`) into
+    /// `columns`: the Jacobian's columns, then the residuals; adds their
+    /// relative errors to `sums`. Column by column, from the terms'
+    /// columns, so that the loops are plain array arithmetic.
+    fn put_columns<const W: usize, const REPORT: bool>(
+        &self,
+        terms: &PairTerms,
+        block: &Block<'_>,
+        first: usize,
+        columns: &mut RunColumns,
+        dr_dm: &mut Vec<f64>,
+        sums: &mut GramSums<W>,
+    ) {
         let channels = self.channels;
-        let columns: &[(Target, f64)] = &self.columns[..W - 1];
-        let mut gram = [[0.0; W]; W];
-        let mut meat = [[0.0; W]; W];
-        let mut x = [0.0; W];
-        let mut grad = Gradient::default();
-        let mut sum_rel = 0.0;
-        let mut scratch = GeometryBatch::new();
-        for i in start..end {
+        let n = terms.len();
+        columns.reset(n * channels, W);
+        dr_dm.clear();
+        let residuals = columns.column_mut(W - 1);
+        for j in 0..n {
+            let i = first + j;
             let s = &block.samples[i];
-            let f = if block.pairs.is_some() {
-                self.average_with_gradient(block, i, &mut grad, &mut scratch)
-            } else {
-                self.value_with_gradient(block.light, s.view, &mut grad)
-            };
             for ch in 0..channels {
                 let row = i * channels + ch;
-                let (res, dr_dm, rel2) = self.residual(f[ch], s.value[ch], block.factors[row]);
+                let (res, d, rel2) = self.residual(
+                    terms.value(j, ch),
+                    s.value[ch],
+                    block.factors[row],
+                    block.log_value(row),
+                );
                 if REPORT {
-                    sum_rel += rel2;
+                    sums.sum_rel += rel2;
                 }
-                for (xj, &(target, dp_du)) in x.iter_mut().zip(columns) {
-                    let dm_dp = match target {
-                        Target::Arg(a) => self.scale * grad.d[a][ch],
-                        Target::Gray => {
-                            self.scale * (grad.d[0][ch] + grad.d[1][ch] + grad.d[2][ch])
+                residuals[j * channels + ch] = res;
+                dr_dm.push(d);
+            }
+        }
+        for (c, &(target, dp_du)) in self.columns[..W - 1].iter().enumerate() {
+            let out = columns.column_mut(c);
+            for ch in 0..channels {
+                // dm/dp: the scale times ∂f/∂p, or f for the scale itself.
+                // A grey parameter drives all three colours; only channel
+                // ch's own colour moves f_ch.
+                let (source, factor) = match target {
+                    Target::Arg(a) => (terms.derivative_column(a, ch), self.scale * dp_du),
+                    Target::Gray => (terms.derivative_column(ch, ch), self.scale * dp_du),
+                    Target::Scale => (Some(terms.value_column(ch)), dp_du),
+                };
+                match source {
+                    Some(source) => {
+                        for (j, &d) in source.iter().enumerate() {
+                            let r = j * channels + ch;
+                            out[r] = dr_dm[r] * d * factor;
                         }
-                        Target::Scale => f[ch],
-                    };
-                    *xj = dr_dm * dm_dp * dp_du;
-                }
-                x[W - 1] = res;
-                for a in 0..W {
-                    for b in a..W {
-                        gram[a][b] += x[a] * x[b];
                     }
-                }
-                if REPORT {
-                    let r2 = res * res;
-                    for a in 0..W - 1 {
-                        for b in a..W - 1 {
-                            meat[a][b] += r2 * x[a] * x[b];
+                    None => {
+                        for j in 0..n {
+                            out[j * channels + ch] = 0.0;
                         }
                     }
                 }
             }
         }
-        let mut data: Vec<f64> = gram.iter().flatten().copied().collect();
-        if REPORT {
-            data.extend(meat.iter().flatten());
-        }
-        ChunkResult {
-            finite: data.iter().all(|v| v.is_finite()),
-            data,
-            sum_rel,
-        }
     }
 
-    /// The BSDF at (light, view) and its gradient (channel 0 only for
-    /// one-channel fits).
+    /// Adds sample `i`'s rows (one per channel) to `sums`, for model value
+    /// `f` and `∂f_ch/∂argument a = d(a, ch)`.
     #[inline(always)]
-    fn value_with_gradient(&self, light: DVec3, view: DVec3, grad: &mut Gradient) -> [f64; 3] {
-        let g = &self.bsdf.geometry(light, view);
-        if self.channels == 1 {
-            self.bsdf.eval_geometry_channels_with_gradient::<1>(g, grad)
-        } else {
-            self.bsdf.eval_geometry_with_gradient(g, grad)
+    fn add_rows<const W: usize, const REPORT: bool>(
+        &self,
+        sums: &mut GramSums<W>,
+        block: &Block<'_>,
+        i: usize,
+        f: [f64; 3],
+        d: impl Fn(usize, usize) -> f64,
+    ) {
+        let s = &block.samples[i];
+        let columns: &[(Target, f64)] = &self.columns[..W - 1];
+        let mut x = [0.0; W];
+        for ch in 0..self.channels {
+            let row = i * self.channels + ch;
+            let (res, dr_dm, rel2) =
+                self.residual(f[ch], s.value[ch], block.factors[row], block.log_value(row));
+            if REPORT {
+                sums.sum_rel += rel2;
+            }
+            for (xj, &(target, dp_du)) in x.iter_mut().zip(columns) {
+                let dm_dp = match target {
+                    Target::Arg(a) => self.scale * d(a, ch),
+                    Target::Gray => self.scale * (d(0, ch) + d(1, ch) + d(2, ch)),
+                    Target::Scale => f[ch],
+                };
+                *xj = dr_dm * dm_dp * dp_du;
+            }
+            x[W - 1] = res;
+            for a in 0..W {
+                for b in a..W {
+                    sums.gram[a][b] += x[a] * x[b];
+                }
+            }
+            if REPORT {
+                let r2 = res * res;
+                for a in 0..W - 1 {
+                    for b in a..W - 1 {
+                        sums.meat[a][b] += r2 * x[a] * x[b];
+                    }
+                }
+            }
         }
     }
 
@@ -505,10 +623,11 @@ impl Kernel<'_> {
         }
     }
 
-    /// The residual for BSDF value `f`, measured `y` and factor `k`, dr/dm,
-    /// and the squared relative error for `rms_rel`.
+    /// The residual for BSDF value `f`, measured `y`, factor `k` and
+    /// (log residuals) `log_y = ln(max(y, 0) + floor)`, dr/dm, and the
+    /// squared relative error for `rms_rel`.
     #[inline(always)]
-    fn residual(&self, f: f64, y: f64, k: f64) -> (f64, f64, f64) {
+    fn residual(&self, f: f64, y: f64, k: f64, log_y: f64) -> (f64, f64, f64) {
         let model = self.scale * f;
         let e = model - y;
         let floor = self.floor;
@@ -517,10 +636,81 @@ impl Kernel<'_> {
             ResidualKind::Absolute | ResidualKind::Relative => (k * e, k),
             ResidualKind::Log => {
                 let a = model.max(0.0) + floor;
-                (k * (a.ln() - (y.max(0.0) + floor).ln()), k / a)
+                (k * (a.ln() - log_y), k / a)
             }
         };
         (res, dr_dm, rel2)
+    }
+}
+
+/// The running sums of one chunk's [`Kernel::gram`].
+struct GramSums<const W: usize> {
+    gram: [[f64; W]; W],
+    meat: [[f64; W]; W],
+    sum_rel: f64,
+}
+
+impl<const W: usize> GramSums<W> {
+    fn new() -> Self {
+        GramSums {
+            gram: [[0.0; W]; W],
+            meat: [[0.0; W]; W],
+            sum_rel: 0.0,
+        }
+    }
+}
+
+/// Samples per run of the per-pair kernel: a run's geometry and terms
+/// stay in the first-level cache.
+const RUN: usize = 256;
+
+/// One run of a measured block's samples: their geometry and their
+/// model terms.
+struct Run {
+    geometry: GeometryBatch,
+    terms: PairTerms,
+}
+
+impl Run {
+    fn new() -> Run {
+        Run {
+            geometry: GeometryBatch::with_capacity(RUN),
+            terms: PairTerms::new(),
+        }
+    }
+
+    /// `f` (and with `GRAD` its gradient) of `block`'s samples `range`,
+    /// from the block's geometry or else the run's own.
+    fn evaluate<const GRAD: bool>(
+        &mut self,
+        kernel: &Kernel<'_>,
+        block: &Block<'_>,
+        range: Range<usize>,
+    ) {
+        let (geometry, range) = match &block.sample_geometry {
+            Some(cached) => (&**cached, range),
+            None => {
+                self.geometry.clear();
+                for s in &block.samples[range] {
+                    self.geometry
+                        .push(kernel.bsdf.geometry(block.light, s.view));
+                }
+                (&self.geometry, 0..self.geometry.len())
+            }
+        };
+        let (bsdf, terms) = (&kernel.bsdf, &mut self.terms);
+        match (GRAD, kernel.channels) {
+            (true, 1) => bsdf.eval_geometry_each_with_gradient::<1>(geometry, range, terms),
+            (true, _) => bsdf.eval_geometry_each_with_gradient::<3>(geometry, range, terms),
+            (false, 1) => bsdf.eval_geometry_each::<1>(geometry, range, terms),
+            (false, _) => bsdf.eval_geometry_each::<3>(geometry, range, terms),
+        }
+    }
+
+    /// Sample `j` of the run's `f`.
+    #[inline(always)]
+    fn value(&self, j: usize) -> [f64; 3] {
+        std::array::from_fn(|ch| self.terms.value(j, ch))
     }
 }
 

@@ -186,13 +186,15 @@ pub fn fit_set_with_data(
     progress.begin(steps as u64);
     // The energy and peak diagnostics follow the main fits there, while
     // the second fits may still run.
+    // What the fitter reads of each input, made once for both fits.
+    let data = incidence_data(&inputs);
     let (main, early) = rayon::join(
         || {
-            let (reports, global) = fit_all(&inputs, &config, progress)?;
+            let (reports, global) = fit_all(&data, &config, progress)?;
             let adequacy = other_early.then(|| diagnose_all(&inputs, &reports, &config));
             Ok::<_, FitSetError>((reports, global, adequacy))
         },
-        || other_early.then(|| other_fits(&inputs, &config, progress)),
+        || other_early.then(|| other_fits(&data, &config, progress)),
     );
     progress.end();
     let (mut reports, mut global, early_adequacy) = main?;
@@ -230,7 +232,7 @@ pub fn fit_set_with_data(
         };
         config.free_scale = false;
         progress.begin(fit_all_steps(inputs.len()) as u64);
-        let refit = fit_all(&inputs, &config, progress);
+        let refit = fit_all(&incidence_data(&inputs), &config, progress);
         progress.end();
         (reports, global) = refit?;
     }
@@ -240,7 +242,7 @@ pub fn fit_set_with_data(
             Some(others) => others,
             None => {
                 progress.begin(inputs.len() as u64);
-                let others = other_fits(&inputs, &config, progress);
+                let others = other_fits(&incidence_data(&inputs), &config, progress);
                 progress.end();
                 others
             }
@@ -408,17 +410,16 @@ fn instrument_scale(
 /// [`diagnose::other_residual`]) and no robust loss: the adequacy
 /// diagnostics' second fit. `None` where that fit fails.
 fn other_fits(
-    inputs: &[Input],
+    data: &[IncidenceData],
     config: &FitConfig,
     progress: &dyn Progress,
 ) -> Vec<Option<FitReport>> {
     let mut other_config = config.clone();
     other_config.residual = diagnose::other_residual(config.residual);
     other_config.loss = crate::RobustLoss::None;
-    inputs
-        .par_iter()
-        .map(|i| {
-            let r = fit_incidence(&i.prepared.incidence_data(), &other_config).ok();
+    data.par_iter()
+        .map(|d| {
+            let r = fit_incidence(d, &other_config).ok();
             progress.advance();
             r
         })
@@ -460,6 +461,15 @@ fn assess(
     }
 }
 
+/// The fitter's view of every input (see
+/// [`PreparedMeasurement::incidence_data`]), in parallel.
+fn incidence_data(inputs: &[Input]) -> Vec<IncidenceData> {
+    inputs
+        .par_iter()
+        .map(|i| i.prepared.incidence_data())
+        .collect()
+}
+
 /// The progress steps of [`fit_all`] on `incidences` incidences.
 fn fit_all_steps(incidences: usize) -> usize {
     incidences + 1
@@ -468,13 +478,12 @@ fn fit_all_steps(incidences: usize) -> usize {
 /// Fits every incidence and all of them at once, in parallel. The caller
 /// begins and ends the progress ([`fit_all_steps`] steps).
 fn fit_all(
-    inputs: &[Input],
+    data: &[IncidenceData],
     config: &FitConfig,
     progress: &dyn Progress,
 ) -> Result<(Vec<FitReport>, FitReport), FitSetError> {
-    let data: Vec<IncidenceData> = inputs.iter().map(|i| i.prepared.incidence_data()).collect();
     // Patch pairs' geometry is computed once for both fits of each incidence.
-    let geometry = shared_pair_geometry(&data, config)?;
+    let geometry = shared_pair_geometry(data, config)?;
     let geometry = geometry.as_deref();
     let (reports, global) = rayon::join(
         || {
@@ -492,7 +501,7 @@ fn fit_all(
             if data.len() < 2 {
                 return None;
             }
-            let r = fit_global_sharing(&data, config, geometry);
+            let r = fit_global_sharing(data, config, geometry);
             progress.advance();
             Some(r)
         },

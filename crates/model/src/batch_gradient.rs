@@ -290,6 +290,304 @@ fn sum_kernel<
     pulp::Arch::new().dispatch(SumOp::<GRAD, CH, ANISO, TRANS, V, FRESNEL> { k, g })
 }
 
+/// Every pair's `f` and gradient, from [`Bsdf::eval_geometry_each`] and
+/// [`Bsdf::eval_geometry_each_with_gradient`]: what
+/// [`Bsdf::eval_geometry_channels_with_gradient`] gives pair by pair, in
+/// structure-of-arrays form. Reused between calls, it keeps its storage.
+#[derive(Debug, Clone, Default)]
+pub struct PairTerms {
+    /// Pairs held.
+    len: usize,
+    /// Each quantity's column length: `len` rounded up to whole vectors.
+    stride: usize,
+    /// Channels evaluated (`CH`).
+    channels: usize,
+    /// Term rows held (see `term_rows`).
+    rows: usize,
+    /// Quantity `q = row · channels + ch` of pair `i` at `q · stride + i`.
+    data: Vec<f64>,
+}
+
+impl PairTerms {
+    /// Empty.
+    pub fn new() -> PairTerms {
+        PairTerms::default()
+    }
+
+    /// Number of pairs.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// True if there are none.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// `f` of pair `i`, channel `ch` (0 beyond the channels evaluated).
+    #[inline(always)]
+    pub fn value(&self, i: usize, ch: usize) -> f64 {
+        if ch < self.channels {
+            self.data[ch * self.stride + i]
+        } else {
+            0.0
+        }
+    }
+
+    /// `∂f_ch/∂argument a` of pair `i`: entry `d[a][ch]` of the
+    /// [`Gradient`] that [`Bsdf::eval_geometry_channels_with_gradient`]
+    /// fills (0 for the arguments the type does not have, and without
+    /// gradients).
+    #[inline(always)]
+    pub fn derivative(&self, i: usize, a: usize, ch: usize) -> f64 {
+        // Row 1 is ∂f_c/∂colour_c; row r ≥ 2 is ∂f/∂(argument r + 1).
+        let row = if a < 3 {
+            if a != ch {
+                return 0.0;
+            }
+            1
+        } else {
+            a - 1
+        };
+        if row < self.rows && ch < self.channels {
+            self.data[(row * self.channels + ch) * self.stride + i]
+        } else {
+            0.0
+        }
+    }
+
+    /// `f` of every pair, channel `ch < CH`, as one slice.
+    ///
+    /// # Panics
+    /// If `ch` is not among the channels evaluated.
+    pub fn value_column(&self, ch: usize) -> &[f64] {
+        assert!(ch < self.channels, "channel {ch} was not evaluated");
+        &self.data[ch * self.stride..ch * self.stride + self.len]
+    }
+
+    /// `∂f_ch/∂argument a` of every pair as one slice (see
+    /// [`PairTerms::derivative`]), or `None` where it is 0 for every pair
+    /// (another channel's colour, an argument the type does not have, no
+    /// gradients, or a channel not evaluated).
+    pub fn derivative_column(&self, a: usize, ch: usize) -> Option<&[f64]> {
+        let row = if a < 3 {
+            if a != ch {
+                return None;
+            }
+            1
+        } else {
+            a - 1
+        };
+        (row < self.rows && ch < self.channels).then(|| {
+            let start = (row * self.channels + ch) * self.stride;
+            &self.data[start..start + self.len]
+        })
+    }
+
+    /// Room for `len` pairs of `rows` rows and `channels` channels.
+    fn reset(&mut self, len: usize, rows: usize, channels: usize) {
+        self.len = len;
+        self.stride = len.div_ceil(MAX_LANES) * MAX_LANES;
+        self.rows = rows;
+        self.channels = channels;
+        // Every entry read is written by the kernel first: no clearing.
+        let needed = rows * channels * self.stride;
+        if self.data.len() < needed {
+            self.data.resize(needed, 0.0);
+        }
+    }
+
+    /// The storage the kernel writes: each quantity's column.
+    fn columns_mut(&mut self) -> &mut [f64] {
+        let needed = self.rows * self.channels * self.stride;
+        &mut self.data[..needed]
+    }
+}
+
+/// The widest SIMD vector in f64 lanes (AVX-512): [`PairTerms`] columns
+/// are whole vectors at every level.
+const MAX_LANES: usize = 8;
+
+impl Bsdf {
+    /// `f` (channels `< CH`) of every pair `range` of `g` (made under this
+    /// type, orientation and options), into `out`: what
+    /// [`Bsdf::eval_geometry`] gives pair by pair, to `exp`'s 2 ulp.
+    ///
+    /// # Panics
+    /// If `range` is not within `0..g.len()`, or `CH > 3`.
+    pub fn eval_geometry_each<const CH: usize>(
+        &self,
+        g: &GeometryBatch,
+        range: Range<usize>,
+        out: &mut PairTerms,
+    ) {
+        self.each_dispatch::<false, CH>(g.columns(range), out);
+    }
+
+    /// `f` and its gradient (channels `< CH`) of every pair `range` of
+    /// `g`, into `out`: what
+    /// [`Bsdf::eval_geometry_channels_with_gradient::<CH>`] gives pair by
+    /// pair (to `exp`'s 2 ulp), with the vectorised kernel of
+    /// [`Bsdf::sum_geometry_with_gradient`].
+    ///
+    /// [`Bsdf::eval_geometry_channels_with_gradient::<CH>`]: Bsdf::eval_geometry_channels_with_gradient
+    ///
+    /// # Panics
+    /// If `range` is not within `0..g.len()`, or `CH > 3`.
+    pub fn eval_geometry_each_with_gradient<const CH: usize>(
+        &self,
+        g: &GeometryBatch,
+        range: Range<usize>,
+        out: &mut PairTerms,
+    ) {
+        self.each_dispatch::<true, CH>(g.columns(range), out);
+    }
+
+    /// Picks the per-pair kernel for this material's switches.
+    fn each_dispatch<const GRAD: bool, const CH: usize>(&self, g: Columns, out: &mut PairTerms) {
+        assert!(CH <= 3, "CH = {CH}: at most 3 channels");
+        let anisotropic = self.kind().is_anisotropic();
+        let transmitting = self.kind().is_transmitting();
+        out.reset(
+            g.light_cosine.len(),
+            term_rows(GRAD, anisotropic, transmitting),
+            CH,
+        );
+        let k = self.batch_constants();
+        let variant = self.options().variant;
+        let fresnel = self.has_fresnel();
+        let data = out.columns_mut();
+        macro_rules! run {
+            ($a:literal, $t:literal) => {
+                match (variant, fresnel) {
+                    (Variant::Radiance, true) => {
+                        each_kernel::<GRAD, CH, $a, $t, RADIANCE, true>(&k, g, data)
+                    }
+                    (Variant::Radiance, false) => {
+                        each_kernel::<GRAD, CH, $a, $t, RADIANCE, false>(&k, g, data)
+                    }
+                    (Variant::Manual2004, _) => {
+                        each_kernel::<GRAD, CH, $a, $t, MANUAL2004, false>(&k, g, data)
+                    }
+                    (Variant::Ward1992, _) => {
+                        each_kernel::<GRAD, CH, $a, $t, WARD1992, false>(&k, g, data)
+                    }
+                }
+            };
+        }
+        match (anisotropic, transmitting) {
+            (false, false) => run!(false, false),
+            (false, true) => run!(false, true),
+            (true, false) => run!(true, false),
+            (true, true) => run!(true, true),
+        }
+    }
+}
+
+/// The per-pair terms, compiled for the best SIMD level of this CPU.
+fn each_kernel<
+    const GRAD: bool,
+    const CH: usize,
+    const ANISO: bool,
+    const TRANS: bool,
+    const V: u8,
+    const FRESNEL: bool,
+>(
+    k: &Constants,
+    g: Columns,
+    out: &mut [f64],
+) {
+    pulp::Arch::new().dispatch(EachOp::<GRAD, CH, ANISO, TRANS, V, FRESNEL> { k, g, out });
+}
+
+/// The per-pair kernel as a `pulp` operation (see [`SumOp`]): the same
+/// terms, stored instead of summed.
+struct EachOp<
+    'a,
+    const GRAD: bool,
+    const CH: usize,
+    const ANISO: bool,
+    const TRANS: bool,
+    const V: u8,
+    const FRESNEL: bool,
+> {
+    k: &'a Constants,
+    g: Columns<'a>,
+    out: &'a mut [f64],
+}
+
+impl<
+    const GRAD: bool,
+    const CH: usize,
+    const ANISO: bool,
+    const TRANS: bool,
+    const V: u8,
+    const FRESNEL: bool,
+> pulp::WithSimd for EachOp<'_, GRAD, CH, ANISO, TRANS, V, FRESNEL>
+{
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, simd: S) -> Self::Output {
+        let ops = Ops(simd);
+        let k = self.k;
+        let g = self.g;
+        let rows = term_rows(GRAD, ANISO, TRANS);
+        let quantities = rows * CH;
+        let zero = ops.splat(0.0);
+        let (ci, ci_tail) = S::as_simd_f64s(g.light_cosine);
+        let (co, co_tail) = S::as_simd_f64s(g.view_cosine);
+        let (lf, lf_tail) = S::as_simd_f64s(g.lobe_factor);
+        let (xu, xu_tail) = S::as_simd_f64s(g.x_u);
+        let (xv, xv_tail) = S::as_simd_f64s(g.x_v);
+        let (cut, cut_tail) = S::as_simd_f64s(g.cutoff_factor);
+        let n = ci.len();
+        let (co, lf, xu) = (&co[..n], &lf[..n], &xu[..n]);
+        let (xv, cut) = if ANISO {
+            (&xv[..n], &cut[..n])
+        } else {
+            (&xv[..0], &cut[..0])
+        };
+        // Each quantity's column is whole vectors long (PairTerms::reset).
+        let (out, _) = S::as_mut_simd_f64s(self.out);
+        let vectors = out.len().checked_div(quantities).unwrap_or(0);
+        let mut store = |i: usize, t: &[[S::f64s; 3]; ROWS]| {
+            for row in 0..rows {
+                for ch in 0..CH {
+                    out[(row * CH + ch) * vectors + i] = t[row][ch];
+                }
+            }
+        };
+        for i in 0..n {
+            let (v, c) = if ANISO { (xv[i], cut[i]) } else { (zero, zero) };
+            let t = simd_terms::<S, GRAD, CH, ANISO, TRANS, V, FRESNEL>(
+                ops, k, ci[i], co[i], lf[i], xu[i], v, c,
+            );
+            store(i, &t);
+        }
+        if !ci_tail.is_empty() {
+            // Lanes past the end load 0 and give 0.
+            let load = |tail: &[f64]| simd.partial_load_f64s(tail);
+            let (v, c) = if ANISO {
+                (load(xv_tail), load(cut_tail))
+            } else {
+                (zero, zero)
+            };
+            let t = simd_terms::<S, GRAD, CH, ANISO, TRANS, V, FRESNEL>(
+                ops,
+                k,
+                load(ci_tail),
+                load(co_tail),
+                load(lf_tail),
+                load(xu_tail),
+                v,
+                c,
+            );
+            store(n, &t);
+        }
+    }
+}
+
 /// Number of term rows a kernel fills: `f` alone, or `f`, ∂/∂colour,
 /// ∂/∂spec, ∂/∂rough_u, then ∂/∂rough_v (anisotropic) and ∂/∂trans,
 /// ∂/∂tspec (transmitting).

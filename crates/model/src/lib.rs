@@ -41,7 +41,7 @@ pub mod rng;
 
 pub use albedo::{Albedo, albedo, gauss_legendre_rule};
 pub use batch::{Directions, RgbBatch, exp_lane};
-pub use batch_gradient::GeometryBatch;
+pub use batch_gradient::{GeometryBatch, PairTerms};
 pub use bsdf::{Bsdf, Geometry, Gradient, Rgb, ViewSplit};
 pub use kind::{MaterialKind, Variant};
 pub use material::{FTINY, MAX_ARGS, Material, ModelError, check_args};

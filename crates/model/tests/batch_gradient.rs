@@ -2,13 +2,15 @@
 //! vectorised sums over a `GeometryBatch`) equal the sums of the scalar
 //! `eval_geometry_channels_with_gradient::<CH>` / `eval_geometry` over the
 //! same pairs, for every type, variant and switch, on runs of every
-//! length and alignment, with geometry made under other arguments.
+//! length and alignment, with geometry made under other arguments; and
+//! the per-pair kernels (`eval_geometry_each[_with_gradient]`) equal the
+//! scalar values pair by pair.
 
 #![allow(clippy::needless_range_loop)] // channel loops index several arrays at once
 
 use brtf_model::{
     Bsdf, EvalOptions, FRESNEL_K_PYRADIANCE, Geometry, GeometryBatch, Gradient, MAX_ARGS, Material,
-    MaterialKind, Variant, cone_solid_angle, direction,
+    MaterialKind, PairTerms, Variant, cone_solid_angle, direction,
 };
 use glam::DVec3;
 use std::ops::Range;
@@ -234,6 +236,7 @@ fn check_channels<const CH: usize>(
     geometry: &[Geometry],
     range: &Range<usize>,
 ) -> (usize, usize) {
+    check_each::<CH>(bsdf, batch, geometry, range);
     let (f_want, grad_want) = scalar_sums::<CH>(bsdf, geometry, range.clone());
     // Channels from CH on must be left as they were.
     const UNTOUCHED: f64 = 7.25;
@@ -280,6 +283,81 @@ fn check_channels<const CH: usize>(
         nonzero.1 += usize::from(grad.d[4][ch] != 0.0);
     }
     nonzero
+}
+
+/// Pair-by-pair agreement asked of the per-pair kernels, relative to the
+/// pair's largest quantity (a derivative's diffuse and lobe parts can
+/// cancel): only `exp` (≤ 2 ulp from libm) differs from the scalar code
+/// ...
+const EACH_RELATIVE: f64 = 1e-13;
+/// ... and flushes results far below any BSDF value to 0.
+const EACH_FLUSHED: f64 = 1e-250;
+
+/// The per-pair kernels over `range` equal the scalar code pair by pair.
+fn check_each<const CH: usize>(
+    bsdf: &Bsdf,
+    batch: &GeometryBatch,
+    geometry: &[Geometry],
+    range: &Range<usize>,
+) {
+    let mut terms = PairTerms::new();
+    let mut values = PairTerms::new();
+    bsdf.eval_geometry_each_with_gradient::<CH>(batch, range.clone(), &mut terms);
+    bsdf.eval_geometry_each::<CH>(batch, range.clone(), &mut values);
+    assert_eq!((terms.len(), values.len()), (range.len(), range.len()));
+    assert_eq!(terms.is_empty(), range.is_empty());
+    // The column views hold the same numbers.
+    for ch in 0..CH {
+        let column = terms.value_column(ch);
+        assert_eq!(column.len(), range.len());
+        for (i, &v) in column.iter().enumerate() {
+            assert_eq!(v, terms.value(i, ch));
+        }
+        for arg in 0..MAX_ARGS {
+            match terms.derivative_column(arg, ch) {
+                Some(column) => {
+                    for (i, &v) in column.iter().enumerate() {
+                        assert_eq!(v, terms.derivative(i, arg, ch));
+                    }
+                }
+                None => {
+                    assert!((0..range.len()).all(|i| terms.derivative(i, arg, ch) == 0.0))
+                }
+            }
+            assert!(values.derivative_column(arg, ch).is_none());
+        }
+    }
+    let mut grad = Gradient::default();
+    for (i, g) in geometry[range.clone()].iter().enumerate() {
+        let f = bsdf.eval_geometry_channels_with_gradient::<CH>(g, &mut grad);
+        let largest = grad
+            .d
+            .iter()
+            .flatten()
+            .chain(&f)
+            .fold(0.0f64, |m, x| m.max(x.abs()));
+        let close = |got: f64, want: f64, what: &str| {
+            assert!(
+                (got - want).abs() <= EACH_RELATIVE * largest + EACH_FLUSHED,
+                "{} {:?} args {:?} CH={CH} pair {}: {what} {got:e} vs scalar {want:e}",
+                bsdf.kind(),
+                bsdf.options(),
+                bsdf.material().args(),
+                range.start + i,
+            )
+        };
+        for ch in 0..3 {
+            let want = if ch < CH { f[ch] } else { 0.0 };
+            close(terms.value(i, ch), want, "f");
+            close(values.value(i, ch), want, "values-only f");
+            for arg in 0..MAX_ARGS {
+                let want = if ch < CH { grad.d[arg][ch] } else { 0.0 };
+                close(terms.derivative(i, arg, ch), want, &format!("d[{arg}]"));
+                // Without gradients there are none.
+                assert_eq!(values.derivative(i, arg, ch), 0.0);
+            }
+        }
+    }
 }
 
 fn check_kind(kind: MaterialKind) {
