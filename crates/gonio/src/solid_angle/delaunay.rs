@@ -29,7 +29,8 @@ pub(crate) const NONE: u32 = u32::MAX;
 
 /// A triangulation in halfedge form (see the module docs).
 pub(crate) struct Triangulation {
-    /// Three vertex indices per triangle, counter-clockwise.
+    /// Three vertex indices per triangle, counter-clockwise; all three
+    /// [`NONE`] for an unused slot (left by [`triangulate_in_polygon_split`]).
     pub triangles: Vec<u32>,
     /// The twin of each halfedge, or [`NONE`].
     pub halfedges: Vec<u32>,
@@ -102,36 +103,363 @@ fn in_circle(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> f64 {
 pub(crate) fn triangulate_in_polygon(
     points: &[[f64; 2]],
     corners: usize,
-    order: impl IntoIterator<Item = u32>,
+    order: &[u32],
 ) -> Option<Triangulation> {
-    if corners < 3 || points.len() < corners || points.len() >= (NONE / 2) as usize {
+    let len = 3 * triangle_count(corners, order.len());
+    let mut triangles = vec![0; len];
+    let mut halfedges = vec![0; len];
+    triangulate_into(points, corners, order, &mut triangles, &mut halfedges)?;
+    Some(Triangulation {
+        triangles,
+        halfedges,
+    })
+}
+
+/// Triangles of `inner` points strictly inside a convex polygon with
+/// `corners` corners (Euler's formula).
+fn triangle_count(corners: usize, inner: usize) -> usize {
+    corners.saturating_sub(2) + 2 * inner
+}
+
+/// [`triangulate_in_polygon`] into the given slices, of exactly
+/// `3 * triangle_count(corners, order.len())` entries each; the halfedges
+/// are numbered from the start of the slices.
+fn triangulate_into(
+    points: &[[f64; 2]],
+    corners: usize,
+    order: &[u32],
+    triangles: &mut [u32],
+    halfedges: &mut [u32],
+) -> Option<()> {
+    let len = 3 * triangle_count(corners, order.len());
+    if corners < 3
+        || points.len() < corners
+        || points.len() >= (NONE / 8) as usize
+        || triangles.len() != len
+        || halfedges.len() != len
+    {
         return None;
     }
-    let capacity = 3 * (2 * points.len());
-    let mut tri = Triangulation {
-        triangles: Vec::with_capacity(capacity),
-        halfedges: Vec::with_capacity(capacity),
-    };
     // Fan from corner 0: triangle k - 1 is (0, k, k + 1).
     let fan = corners as u32 - 2;
     for k in 1..=fan {
-        tri.triangles.extend([0, k, k + 1]);
         let t = k - 1;
+        let base = 3 * t as usize;
+        triangles[base..base + 3].copy_from_slice(&[0, k, k + 1]);
         let into_previous = if k == 1 { NONE } else { 3 * (t - 1) + 2 };
         let into_next = if k == fan { NONE } else { 3 * (t + 1) };
-        tri.halfedges.extend([into_previous, NONE, into_next]);
+        halfedges[base..base + 3].copy_from_slice(&[into_previous, NONE, into_next]);
     }
     let mut inserter = Inserter {
         points,
-        tri,
+        triangles,
+        halfedges,
+        used: 3 * fan as usize,
         stack: Vec::with_capacity(64),
         last: 0,
-        walk_budget: 0,
     };
-    for p in order {
+    for &p in order {
         inserter.insert(p)?;
     }
-    Some(inserter.tri)
+    Some(())
+}
+
+/// Below this many points (besides the corners) one thread triangulates
+/// them all: splitting costs a seam triangulation and a merge.
+const SPLIT_MIN_POINTS: usize = 4096;
+
+/// Delaunay triangulation of `points`, whose first `corners` entries are the
+/// counter-clockwise corners of a convex polygon that strictly contains all
+/// the others, which must be distinct and in spatial (Hilbert) order. Each
+/// point is inserted in [`brio_order`]. With two or more threads and enough
+/// points, the two halves left and right of a vertical line are
+/// triangulated in parallel and merged ([`triangulate_in_polygon_split`]);
+/// the result may then contain unused triangle slots. `None` as for
+/// [`triangulate_in_polygon`].
+pub(crate) fn triangulate_spatially_ordered(
+    points: &[[f64; 2]],
+    corners: usize,
+) -> Option<Triangulation> {
+    let inner = points.len().saturating_sub(corners);
+    if inner >= SPLIT_MIN_POINTS
+        && rayon::current_num_threads() >= 2
+        && let Some(tri) = triangulate_in_polygon_split(points, corners)
+    {
+        return Some(tri);
+    }
+    let order: Vec<u32> = brio_order(inner)
+        .into_iter()
+        .map(|k| k + corners as u32)
+        .collect();
+    triangulate_in_polygon(points, corners, &order)
+}
+
+/// What the merge needs from one half's Delaunay triangulation (made with
+/// the polygon's corners, in its share of the merged slots).
+struct Half {
+    /// Kept triangles: their circumcircle lies strictly on the half's side
+    /// of the split line, so no point of the other half is inside it and
+    /// the triangle is one of the whole set's Delaunay triangles. The
+    /// others are marked unused in the slots.
+    kept: usize,
+    /// The non-corner vertices of the triangles not kept.
+    seam: Vec<u32>,
+    /// The halfedges (merged numbering) of kept triangles whose twin is a
+    /// triangle not kept: the edges between the kept part and the seam
+    /// region.
+    boundary: Vec<u32>,
+}
+
+/// Triangulates the polygon's corners and `members` (one half's points,
+/// ascending, i.e. in spatial order) into `triangles` and `halfedges`,
+/// which start at halfedge `offset` of the merged numbering, and keeps
+/// the triangles whose vertices and circumcircle lie strictly left
+/// (`left`) or right of the line x = `split`.
+#[allow(clippy::too_many_arguments)]
+fn triangulate_half(
+    points: &[[f64; 2]],
+    corners: usize,
+    members: &[u32],
+    split: f64,
+    left: bool,
+    triangles: &mut [u32],
+    halfedges: &mut [u32],
+    offset: u32,
+) -> Option<Half> {
+    let order: Vec<u32> = brio_order(members.len())
+        .into_iter()
+        .map(|k| members[k as usize])
+        .collect();
+    triangulate_into(points, corners, &order, triangles, halfedges)?;
+    // Signed distance beyond the line, positive on this half's side.
+    let beyond = |x: f64| if left { split - x } else { x - split };
+    let kept: Vec<bool> = triangles
+        .chunks_exact(3)
+        .map(|t| {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| points[i as usize]);
+            if !(beyond(a[0]) > 0.0 && beyond(b[0]) > 0.0 && beyond(c[0]) > 0.0) {
+                return false;
+            }
+            // The circle clear of the line, with a margin for rounding (a
+            // wrong call here is caught by the merge's checks).
+            let centre = circumcentre(a, b, c);
+            let radius2 = (centre[0] - a[0]).powi(2) + (centre[1] - a[1]).powi(2);
+            let gap = beyond(centre[0]);
+            gap > 0.0 && gap * gap > radius2 * (1.0 + 1e-9)
+        })
+        .collect();
+    let mut seen = vec![false; points.len()];
+    let mut seam = Vec::new();
+    let mut boundary = Vec::new();
+    for (t, &is_kept) in kept.iter().enumerate() {
+        let slots = 3 * t..3 * t + 3;
+        if is_kept {
+            for e in slots {
+                let twin = halfedges[e];
+                if twin != NONE && !kept[twin as usize / 3] {
+                    boundary.push(e as u32 + offset);
+                }
+            }
+        } else {
+            for v in &mut triangles[slots] {
+                let i = *v as usize;
+                if i >= corners && !seen[i] {
+                    seen[i] = true;
+                    seam.push(*v);
+                }
+                *v = NONE;
+            }
+        }
+    }
+    if offset != 0 {
+        for h in halfedges.iter_mut().filter(|h| **h != NONE) {
+            *h += offset;
+        }
+    }
+    Some(Half {
+        kept: kept.iter().filter(|&&k| k).count(),
+        seam,
+        boundary,
+    })
+}
+
+/// The circumcentre of the triangle a, b, c (not finite when it is flat).
+pub(crate) fn circumcentre(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> [f64; 2] {
+    let (bx, by) = (b[0] - a[0], b[1] - a[1]);
+    let (cx, cy) = (c[0] - a[0], c[1] - a[1]);
+    let b2 = bx * bx + by * by;
+    let c2 = cx * cx + cy * cy;
+    let d = 2.0 * (bx * cy - by * cx);
+    [
+        a[0] + (cy * b2 - by * c2) / d,
+        a[1] + (bx * c2 - cx * b2) / d,
+    ]
+}
+
+/// The Delaunay triangulation of [`triangulate_spatially_ordered`], built
+/// on two threads:
+///
+/// 1. The points are split by the vertical line x = s through (about) their
+///    median; each half is triangulated with the polygon's corners, in
+///    parallel, straight into its share of the merged slots.
+/// 2. A triangle of one half whose vertices and circumcircle lie strictly
+///    on its side is *kept*: no point of the other half can be in its
+///    circle, so it is a Delaunay triangle of the whole set.
+/// 3. The rest of the polygon, the seam region, is covered by the
+///    triangulation of the points of the triangles not kept (plus the
+///    corners): every Delaunay triangle of the whole set there is one of
+///    theirs, and its boundary edges are Delaunay edges of the whole set,
+///    so are edges of that small triangulation too. Its triangles inside
+///    the seam region are found by a flood fill from the boundary edges.
+///
+/// Nothing is taken on trust: `None` (and the caller falls back to one
+/// thread) unless every boundary edge is found in the seam triangulation
+/// exactly once, the triangle count is Euler's for the whole set (so the
+/// pieces tile the polygon), and every boundary edge passes the in-circle
+/// test with the triangles on both sides. With the edges inside each piece
+/// Delaunay by construction, the result is then locally Delaunay
+/// everywhere, hence a Delaunay triangulation of all the points. The
+/// halves' triangles not kept stay as unused slots ([`NONE`] vertices).
+pub(crate) fn triangulate_in_polygon_split(
+    points: &[[f64; 2]],
+    corners: usize,
+) -> Option<Triangulation> {
+    if corners < 3 || points.len() < corners + 2 || points.len() >= (NONE / 8) as usize {
+        return None;
+    }
+    // The median abscissa of a sample: the halves need not be equal.
+    let inner = &points[corners..];
+    let stride = (inner.len() / 1024).max(1);
+    let mut sample: Vec<f64> = inner.iter().step_by(stride).map(|p| p[0]).collect();
+    sample.sort_unstable_by(f64::total_cmp);
+    let split = sample[sample.len() / 2];
+    let (left, right): (Vec<u32>, Vec<u32>) =
+        (corners as u32..points.len() as u32).partition(|&i| points[i as usize][0] < split);
+    if left.is_empty() || right.is_empty() {
+        return None;
+    }
+
+    // One allocation for everything: half a's slots, half b's, then room
+    // for the seam's triangles (at most all of them). The zeroed pages are
+    // only touched by the thread that fills them.
+    let slots_a = 3 * triangle_count(corners, left.len());
+    let slots_b = 3 * triangle_count(corners, right.len());
+    let slots_all = 3 * triangle_count(corners, points.len() - corners);
+    let mut triangles = vec![0u32; slots_a + slots_b + slots_all];
+    let mut halfedges = vec![0u32; slots_a + slots_b + slots_all];
+    triangles.truncate(slots_a + slots_b);
+    halfedges.truncate(slots_a + slots_b);
+    let (a, b) = {
+        let (triangles_a, triangles_b) = triangles.split_at_mut(slots_a);
+        let (halfedges_a, halfedges_b) = halfedges.split_at_mut(slots_a);
+        rayon::join(
+            || {
+                let (t, h) = (triangles_a, halfedges_a);
+                triangulate_half(points, corners, &left, split, true, t, h, 0)
+            },
+            || {
+                let (t, h, offset) = (triangles_b, halfedges_b, slots_a as u32);
+                triangulate_half(points, corners, &right, split, false, t, h, offset)
+            },
+        )
+    };
+    let (a, b) = (a?, b?);
+
+    // The seam region's triangulation (its vertices in spatial order).
+    let mut seam: Vec<u32> = a.seam.iter().chain(&b.seam).copied().collect();
+    seam.sort_unstable();
+    let order: Vec<u32> = brio_order(seam.len())
+        .into_iter()
+        .map(|k| seam[k as usize])
+        .collect();
+    let gap = triangulate_in_polygon(points, corners, &order)?;
+    let key = |from: u32, to: u32| (u64::from(from) << 32) | u64::from(to);
+    let mut by_ends: Vec<(u64, u32)> = (0..gap.triangles.len() as u32)
+        .map(|e| {
+            let from = gap.triangles[e as usize];
+            (key(from, gap.triangles[next(e) as usize]), e)
+        })
+        .collect();
+    by_ends.sort_unstable();
+
+    // Pair each boundary halfedge with its twin in the seam triangulation
+    // (`partner`, merged numbering), checking the in-circle test.
+    let mut partner = vec![NONE; gap.triangles.len()];
+    let pt = |i: u32| points[i as usize];
+    for &e in a.boundary.iter().chain(&b.boundary) {
+        let u = triangles[e as usize];
+        let v = triangles[next(e) as usize];
+        let w = triangles[prev(e) as usize];
+        let at = by_ends.binary_search_by_key(&key(v, u), |&(k, _)| k).ok()?;
+        let g = by_ends[at].1;
+        if partner[g as usize] != NONE {
+            return None;
+        }
+        partner[g as usize] = e;
+        let d = gap.triangles[prev(g) as usize];
+        if in_circle(pt(u), pt(v), pt(w), pt(d)) > 0.0 {
+            return None;
+        }
+    }
+
+    // The seam triangles: flood fill from the boundary, not across it.
+    let mut new_index = vec![NONE; gap.triangles.len() / 3];
+    let mut inside: Vec<u32> = Vec::new();
+    let mut stack: Vec<u32> = Vec::new();
+    for (g, &p) in partner.iter().enumerate() {
+        let t = g as u32 / 3;
+        if p != NONE && new_index[t as usize] == NONE {
+            new_index[t as usize] = inside.len() as u32;
+            inside.push(t);
+            stack.push(t);
+        }
+    }
+    while let Some(t) = stack.pop() {
+        for g in 3 * t..3 * t + 3 {
+            let twin = gap.halfedges[g as usize];
+            if partner[g as usize] != NONE || twin == NONE {
+                continue;
+            }
+            let u = twin / 3;
+            if new_index[u as usize] == NONE {
+                new_index[u as usize] = inside.len() as u32;
+                inside.push(u);
+                stack.push(u);
+            }
+        }
+    }
+
+    // The pieces tile the polygon only if they have Euler's count.
+    if a.kept + b.kept + inside.len() != triangle_count(corners, points.len() - corners) {
+        return None;
+    }
+
+    // Append the seam triangles and link them to the kept ones.
+    let first = triangles.len() as u32;
+    let merged = |g: u32| first + 3 * new_index[g as usize / 3] + g % 3;
+    for &t in &inside {
+        for g in 3 * t..3 * t + 3 {
+            triangles.push(gap.triangles[g as usize]);
+            let p = partner[g as usize];
+            let twin = gap.halfedges[g as usize];
+            halfedges.push(if p != NONE {
+                p
+            } else if twin == NONE {
+                NONE
+            } else {
+                merged(twin)
+            });
+        }
+    }
+    for (g, &p) in partner.iter().enumerate() {
+        if p != NONE {
+            halfedges[p as usize] = merged(g as u32);
+        }
+    }
+    Some(Triangulation {
+        triangles,
+        halfedges,
+    })
 }
 
 /// A biased randomised insertion order (BRIO) of `count` points given in
@@ -179,12 +507,16 @@ pub(crate) fn brio_order(count: usize) -> Vec<u32> {
 
 struct Inserter<'a> {
     points: &'a [[f64; 2]],
-    tri: Triangulation,
+    /// The triangles' vertices (see [`Triangulation`]); the first `used`
+    /// entries are filled.
+    triangles: &'a mut [u32],
+    /// The halfedges' twins, parallel to `triangles`.
+    halfedges: &'a mut [u32],
+    used: usize,
     /// Halfedges waiting for the in-circle test.
     stack: Vec<u32>,
     /// A triangle touching the previously inserted point: the walk's start.
     last: u32,
-    walk_budget: usize,
 }
 
 impl Inserter<'_> {
@@ -202,22 +534,17 @@ impl Inserter<'_> {
     /// visibility walk from `self.last` that crosses any edge `point` lies
     /// strictly beyond, trying the edges in turn after the one it came in by.
     fn locate(&mut self, point: [f64; 2]) -> Option<u32> {
-        let tri = &self.tri;
+        let (triangles, halfedges) = (&*self.triangles, &*self.halfedges);
         let mut t = self.last;
         let mut entry = 0u32;
         // A Delaunay walk visits each triangle at most once.
-        self.walk_budget = tri.triangles.len() / 3 + 1;
-        'walk: loop {
-            if self.walk_budget == 0 {
-                return None;
-            }
-            self.walk_budget -= 1;
+        'walk: for _ in 0..=self.used / 3 {
             for k in 0..3 {
                 let e = 3 * t + (entry + k) % 3;
-                let a = self.points[tri.triangles[e as usize] as usize];
-                let b = self.points[tri.triangles[next(e) as usize] as usize];
+                let a = self.points[triangles[e as usize] as usize];
+                let b = self.points[triangles[next(e) as usize] as usize];
                 if orient(a, b, point) < 0.0 {
-                    let twin = tri.halfedges[e as usize];
+                    let twin = halfedges[e as usize];
                     if twin == NONE {
                         return None; // outside the polygon
                     }
@@ -228,12 +555,13 @@ impl Inserter<'_> {
             }
             return Some(t);
         }
+        None
     }
 
     fn link(&mut self, a: u32, b: u32) {
-        self.tri.halfedges[a as usize] = b;
+        self.halfedges[a as usize] = b;
         if b != NONE {
-            self.tri.halfedges[b as usize] = a;
+            self.halfedges[b as usize] = a;
         }
     }
 
@@ -243,17 +571,18 @@ impl Inserter<'_> {
     fn split(&mut self, t: u32, p: u32) {
         let base = 3 * t as usize;
         let [a, b, c] = [
-            self.tri.triangles[base],
-            self.tri.triangles[base + 1],
-            self.tri.triangles[base + 2],
+            self.triangles[base],
+            self.triangles[base + 1],
+            self.triangles[base + 2],
         ];
-        let twin_bc = self.tri.halfedges[base + 1];
-        let twin_ca = self.tri.halfedges[base + 2];
-        let t1 = (self.tri.triangles.len() / 3) as u32;
+        let twin_bc = self.halfedges[base + 1];
+        let twin_ca = self.halfedges[base + 2];
+        let t1 = (self.used / 3) as u32;
         let t2 = t1 + 1;
-        self.tri.triangles[base + 2] = p;
-        self.tri.triangles.extend([b, c, p, c, a, p]);
-        self.tri.halfedges.extend([NONE; 6]);
+        self.triangles[base + 2] = p;
+        self.triangles[self.used..self.used + 6].copy_from_slice(&[b, c, p, c, a, p]);
+        self.halfedges[self.used..self.used + 6].fill(NONE);
+        self.used += 6;
         // (a, b, p): a→b keeps its twin.
         self.link(3 * t + 1, 3 * t1 + 2); // b→p with p→b
         self.link(3 * t + 2, 3 * t2 + 1); // p→a with a→p
@@ -267,11 +596,11 @@ impl Inserter<'_> {
     /// p. If the vertex d across it lies inside that triangle's circumcircle,
     /// flips u–v to p–d and queues the two edges now facing p.
     fn legalize(&mut self, e: u32) {
-        let twin = self.tri.halfedges[e as usize];
+        let twin = self.halfedges[e as usize];
         if twin == NONE {
             return;
         }
-        let tris = &self.tri.triangles;
+        let tris = &*self.triangles;
         let u = tris[e as usize];
         let v = tris[next(e) as usize];
         let p = tris[prev(e) as usize];
@@ -284,10 +613,10 @@ impl Inserter<'_> {
         // the positions of their halfedges.
         let (a0, a1) = (e, next(e));
         let (b0, b1, b2) = (twin, next(twin), prev(twin));
-        let twin_a1 = self.tri.halfedges[a1 as usize];
-        let twin_b1 = self.tri.halfedges[b1 as usize];
-        self.tri.triangles[a1 as usize] = d;
-        self.tri.triangles[b1 as usize] = p;
+        let twin_a1 = self.halfedges[a1 as usize];
+        let twin_b1 = self.halfedges[b1 as usize];
+        self.triangles[a1 as usize] = d;
+        self.triangles[b1 as usize] = p;
         self.link(a0, twin_b1); // u→d
         self.link(b0, twin_a1); // v→p
         self.link(a1, b1); // d→p with p→d
@@ -303,18 +632,57 @@ mod tests {
         vec![[-10.0, -10.0], [10.0, -10.0], [10.0, 10.0], [-10.0, 10.0]]
     }
 
-    fn check_delaunay(points: &[[f64; 2]], tri: &Triangulation) {
+    /// Checks that `tri` (unused slots allowed) is a Delaunay triangulation
+    /// of all of `points` inside the convex polygon of its first `corners`
+    /// points: counter-clockwise triangles with consistent twins, open
+    /// edges only between consecutive corners, every point a vertex, the
+    /// triangles' areas summing to the polygon's (so they tile it), Euler's
+    /// count, and every edge locally Delaunay.
+    fn check_delaunay(points: &[[f64; 2]], corners: usize, tri: &Triangulation) {
+        let mut used = vec![false; points.len()];
+        let mut live = 0;
+        let mut area = 0.0;
         for (t, v) in tri.triangles.chunks_exact(3).enumerate() {
+            if v[0] == NONE {
+                assert!(v[1] == NONE && v[2] == NONE, "slot {t} half unused");
+                continue;
+            }
+            live += 1;
             let [a, b, c] = [v[0], v[1], v[2]].map(|i| coord(points[i as usize]));
             assert!(
                 orient2d(a, b, c) > 0.0,
                 "triangle {t} not counter-clockwise"
             );
+            area += 0.5 * ((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x));
+            for &i in v {
+                used[i as usize] = true;
+            }
         }
+        assert!(used.iter().all(|&u| u), "a point is no vertex");
+        assert_eq!(live, triangle_count(corners, points.len() - corners));
+        let polygon: f64 = (0..corners)
+            .map(|k| {
+                let (p, q) = (points[k], points[(k + 1) % corners]);
+                0.5 * (p[0] * q[1] - p[1] * q[0])
+            })
+            .sum();
+        assert!(
+            (area - polygon).abs() <= 1e-9 * polygon,
+            "{area} != {polygon}"
+        );
         for (e, &twin) in tri.halfedges.iter().enumerate() {
-            if twin == NONE {
+            if tri.triangles[e] == NONE {
                 continue;
             }
+            if twin == NONE {
+                let (from, to) = (tri.triangles[e], tri.triangles[next(e as u32) as usize]);
+                assert!(
+                    (from as usize) < corners && to as usize == (from as usize + 1) % corners,
+                    "open edge {from}→{to} inside the polygon"
+                );
+                continue;
+            }
+            assert_ne!(tri.triangles[twin as usize], NONE, "edge {e} into a slot");
             assert_eq!(tri.halfedges[twin as usize] as usize, e);
             let e = e as u32;
             assert_eq!(
@@ -344,9 +712,9 @@ mod tests {
             };
             points.push([r(), r()]);
         }
-        let tri = triangulate_in_polygon(&points, 4, 4..points.len() as u32).unwrap();
-        assert_eq!(tri.triangles.len() / 3, 2 * points.len() - 2 - 4);
-        check_delaunay(&points, &tri);
+        let tri = triangulate_in_polygon(&points, 4, &(4..points.len() as u32).collect::<Vec<_>>())
+            .unwrap();
+        check_delaunay(&points, 4, &tri);
     }
 
     #[test]
@@ -357,9 +725,89 @@ mod tests {
                 points.push([i as f64 * 0.25 - 3.0, j as f64 * 0.25 - 3.0]);
             }
         }
-        let tri = triangulate_in_polygon(&points, 4, 4..points.len() as u32).unwrap();
-        assert_eq!(tri.triangles.len() / 3, 2 * points.len() - 2 - 4);
-        check_delaunay(&points, &tri);
+        let tri = triangulate_in_polygon(&points, 4, &(4..points.len() as u32).collect::<Vec<_>>())
+            .unwrap();
+        check_delaunay(&points, 4, &tri);
+    }
+
+    /// `points` after the ghost-like corners of a large square, sorted
+    /// along a Hilbert-like key (here simply by x then y: any order works
+    /// for correctness), triangulated on two threads and checked; the split
+    /// path must not give up on these sets.
+    fn check_split(name: &str, mut inner: Vec<[f64; 2]>) {
+        inner.sort_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
+        inner.dedup();
+        let mut points = square_corners();
+        points.extend(inner);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
+        let tri = pool
+            .install(|| triangulate_in_polygon_split(&points, 4))
+            .unwrap_or_else(|| panic!("{name}: the split triangulation gave up"));
+        check_delaunay(&points, 4, &tri);
+    }
+
+    fn xorshift(state: &mut u64) -> f64 {
+        *state ^= *state << 13;
+        *state ^= *state >> 7;
+        *state ^= *state << 17;
+        (*state >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    #[test]
+    fn split_triangulation_is_delaunay_across_the_seam() {
+        let mut state = 0x5eed_1234_abcd_ef01u64;
+        let uniform: Vec<[f64; 2]> = (0..20_000)
+            .map(|_| {
+                [
+                    xorshift(&mut state) * 16.0 - 8.0,
+                    xorshift(&mut state) * 16.0 - 8.0,
+                ]
+            })
+            .collect();
+        check_split("uniform", uniform);
+
+        // A square grid: whole columns lie on the split line (its median
+        // abscissa) and every grid square's corners are cocircular, with
+        // circles straddling the line.
+        let grid: Vec<[f64; 2]> = (0..120)
+            .flat_map(|i| {
+                (0..120).map(move |j| [i as f64 * 0.125 - 7.4375, j as f64 * 0.125 - 7.5])
+            })
+            .collect();
+        check_split("grid", grid);
+
+        // Concentric rings about a point on the split line: every ring is
+        // one cocircular set cut in two by the line.
+        let rings: Vec<[f64; 2]> = (1..60)
+            .flat_map(|i| {
+                (0..240).map(move |j| {
+                    let (r, a) = (0.12 * i as f64, std::f64::consts::TAU * j as f64 / 240.0);
+                    [r * a.cos(), r * a.sin()]
+                })
+            })
+            .collect();
+        check_split("rings", rings);
+
+        // Near-collinear paths crossing the line, points 1e-3 apart.
+        let mut paths = Vec::new();
+        for _ in 0..60 {
+            let start = [
+                xorshift(&mut state) * 10.0 - 5.0,
+                xorshift(&mut state) * 10.0 - 5.0,
+            ];
+            let angle = xorshift(&mut state) * std::f64::consts::TAU;
+            for k in 0..400 {
+                let s = 1e-3 * k as f64 * (1.0 + 1e-3 * xorshift(&mut state));
+                paths.push([
+                    start[0] + s * angle.cos() * 5.0,
+                    start[1] + s * angle.sin() * 5.0,
+                ]);
+            }
+        }
+        check_split("paths", paths);
     }
 
     #[test]
@@ -398,6 +846,6 @@ mod tests {
         let mut points = square_corners();
         points.push([0.0, 0.0]);
         points.push([20.0, 0.0]);
-        assert!(triangulate_in_polygon(&points, 4, [4, 5]).is_none());
+        assert!(triangulate_in_polygon(&points, 4, &[4, 5]).is_none());
     }
 }

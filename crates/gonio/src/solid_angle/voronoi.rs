@@ -41,7 +41,7 @@ use std::collections::HashMap;
 use delaunator::{EMPTY, Point, next_halfedge, triangulate};
 use rayon::prelude::*;
 
-use super::delaunay::{self, NONE, Triangulation};
+use super::delaunay::{self, NONE, Triangulation, circumcentre};
 use crate::measurement::Hemisphere;
 
 /// Radius of the equal-area disk that one hemisphere maps to (√2).
@@ -120,12 +120,7 @@ pub fn disk_voronoi_areas(points: &[[f64; 2]]) -> Vec<f64> {
         group_of[i as usize] = g as u32;
         group_size[g] += 1;
     }
-    let insertion = delaunay::brio_order(group_size.len());
-    let Some(tri) = delaunay::triangulate_in_polygon(
-        &vertices,
-        GHOSTS,
-        insertion.into_iter().map(|k| k + GHOSTS as u32),
-    ) else {
+    let Some(tri) = delaunay::triangulate_spatially_ordered(&vertices, GHOSTS) else {
         return reference_disk_voronoi_areas(points);
     };
     let Some(cell_areas) = cell_areas(&vertices, &tri) else {
@@ -223,7 +218,10 @@ fn cell_areas(vertices: &[[f64; 2]], tri: &Triangulation) -> Option<Vec<f64>> {
         .par_chunks_exact(3)
         .with_min_len(4096)
         .map(|t| {
-            circumcenter(
+            if t[0] == NONE {
+                return [f64::NAN; 2]; // an unused slot
+            }
+            circumcentre(
                 vertices[t[0] as usize],
                 vertices[t[1] as usize],
                 vertices[t[2] as usize],
@@ -232,9 +230,11 @@ fn cell_areas(vertices: &[[f64; 2]], tri: &Triangulation) -> Option<Vec<f64>> {
         .collect();
     // One halfedge ending at each vertex.
     let mut incoming = vec![NONE; vertices.len()];
-    for (e, _) in tri.triangles.iter().enumerate() {
-        let e = e as u32;
-        incoming[tri.triangles[delaunay::next(e) as usize] as usize] = e;
+    for e in 0..tri.triangles.len() as u32 {
+        let to = tri.triangles[delaunay::next(e) as usize];
+        if to != NONE {
+            incoming[to as usize] = e;
+        }
     }
     let steps = tri.triangles.len();
     incoming[GHOSTS..]
@@ -325,7 +325,7 @@ fn unique_cell_areas(unique: &mut Vec<[f64; 2]>) -> Vec<f64> {
     let circumcenters: Vec<[f64; 2]> = tri
         .triangles
         .chunks_exact(3)
-        .map(|t| circumcenter(unique[t[0]], unique[t[1]], unique[t[2]]))
+        .map(|t| circumcentre(unique[t[0]], unique[t[1]], unique[t[2]]))
         .collect();
     // One halfedge ending at each point.
     let mut incoming = vec![EMPTY; unique.len()];
@@ -402,18 +402,6 @@ fn share_with_nearest(points: &[[f64; 2]], real: usize, missing: &[usize], areas
 
 fn dist2(a: [f64; 2], b: [f64; 2]) -> f64 {
     (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)
-}
-
-fn circumcenter(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> [f64; 2] {
-    let (bx, by) = (b[0] - a[0], b[1] - a[1]);
-    let (cx, cy) = (c[0] - a[0], c[1] - a[1]);
-    let b2 = bx * bx + by * by;
-    let c2 = cx * cx + cy * cy;
-    let d = 2.0 * (bx * cy - by * cx);
-    [
-        a[0] + (cy * b2 - by * c2) / d,
-        a[1] + (bx * c2 - cx * b2) / d,
-    ]
 }
 
 /// Signed area of `polygon ∩ disk(0, radius)` (positive for
