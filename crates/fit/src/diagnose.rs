@@ -16,6 +16,7 @@
 //! Colour data are judged on their luminance (CIE Y), grey data as they are.
 
 use crate::config::FitConfig;
+use crate::data::IncidenceData;
 use crate::recipe::PreparedMeasurement;
 use crate::report::FitReport;
 use brtf_gonio::Hemisphere;
@@ -126,6 +127,22 @@ fn fitted_model(prepared: &PreparedMeasurement, bsdf: &Bsdf) -> Vec<f64> {
         .collect()
 }
 
+/// [`fitted_model`] from the fitter's own view of the same samples
+/// (`data`, made from `prepared`): the same directions, not computed
+/// again. Patch-averaged data go through [`fitted_model`].
+fn fitted_model_at(prepared: &PreparedMeasurement, data: &IncidenceData, bsdf: &Bsdf) -> Vec<f64> {
+    if prepared.patch_pairs.is_some() {
+        return fitted_model(prepared, bsdf);
+    }
+    let channels = prepared.channels();
+    let light = prepared.measurement.incident_direction();
+    data.samples
+        .par_iter()
+        .with_min_len(4096)
+        .map(|s| luminance(bsdf.eval(light, s.view), channels))
+        .collect()
+}
+
 /// [`measured_integrals`] with the model's values `model` from
 /// [`fitted_model`].
 fn measured_sums(prepared: &PreparedMeasurement, model: &[f64], scale: f64) -> Measured {
@@ -156,17 +173,21 @@ pub(crate) fn model_albedo(prepared: &PreparedMeasurement, bsdf: &Bsdf) -> (f64,
 }
 
 /// The energy and peak diagnostics of `report`, fitted to `prepared`
-/// (the residual-kind check is added by the caller).
+/// (whose fitted samples `data` holds; the residual-kind check is added
+/// by the caller).
 pub(crate) fn diagnose(
     prepared: &PreparedMeasurement,
+    data: &IncidenceData,
     report: &FitReport,
     config: &FitConfig,
 ) -> Option<Adequacy> {
     let material = material(config, report)?;
     let bsdf = Bsdf::new(&material, &config.options);
     let scale = report.scale;
-    let (rho_model, tau_model) = model_albedo(prepared, &bsdf);
-    let model = fitted_model(prepared, &bsdf);
+    let ((rho_model, tau_model), model) = rayon::join(
+        || model_albedo(prepared, &bsdf),
+        || fitted_model_at(prepared, data, &bsdf),
+    );
     let measured = measured_sums(prepared, &model, scale);
     // Data's reflectance: measured part ÷ scale, plus the model's rest.
     let complete = |part: Option<(f64, f64)>, model_total: f64| {
@@ -177,7 +198,7 @@ pub(crate) fn diagnose(
         rho_model,
         tau_data: complete(measured.back, tau_model),
         tau_model,
-        peak_offset_deg: peak_offset(prepared, &model),
+        peak_offset_deg: peak_offset(prepared, data, &model),
         residual_check: None,
     })
 }
@@ -186,13 +207,15 @@ pub(crate) fn diagnose(
 /// over the fitted directions of the hemisphere that holds the brightest
 /// data sample. `None` when the data have no distinct peak (their
 /// brightest samples are less than twice their median). `model` holds the
-/// model's values at the fitted samples ([`fitted_model`]).
-fn peak_offset(prepared: &PreparedMeasurement, model: &[f64]) -> Option<f64> {
+/// model's values at the fitted samples ([`fitted_model`]); `data` the
+/// fitter's view of them (their directions).
+fn peak_offset(prepared: &PreparedMeasurement, data: &IncidenceData, model: &[f64]) -> Option<f64> {
     let channels = prepared.channels();
-    let samples: Vec<(DVec3, f64, f64)> = prepared
-        .fitted()
+    let samples: Vec<(DVec3, f64, f64)> = data
+        .samples
+        .iter()
         .zip(model)
-        .map(|((_, s), &f)| (s.direction(), luminance(s.values, channels), f))
+        .map(|(s, &f)| (s.view, luminance(s.value, channels), f))
         .filter(|(_, y, _)| y.is_finite())
         .collect();
     if samples.len() < 10 {

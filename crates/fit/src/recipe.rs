@@ -17,7 +17,11 @@
 
 use crate::data::{FitSample, GateCount, IncidenceData, Weighting};
 use brtf_gonio::{Gate, GateContext, Measurement, Quantity, SolidAngleSource};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+
+/// Samples per parallel piece of the gates.
+const GATE_PIECE: usize = 8192;
 
 /// How the scale of raw-signal files is fixed.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -416,22 +420,31 @@ impl Recipe {
             }
         }
         let (measurement, conversion) = self.convert(&measurement, source)?;
+        // Each sample is removed by the first gate it fails, if any.
         let context = GateContext::of(&measurement);
-        let mut removed_by = vec![None; measurement.len()];
-        let mut gates = Vec::with_capacity(self.selections.len());
-        for (g, gate) in self.selections.iter().enumerate() {
-            let mut removed = 0;
-            for (sample, slot) in measurement.samples.iter().zip(removed_by.iter_mut()) {
-                if slot.is_none() && !gate.keeps(sample, &context) {
-                    *slot = Some(g);
-                    removed += 1;
-                }
-            }
-            gates.push(GateCount {
+        let removed_by: Vec<Option<usize>> = measurement
+            .samples
+            .par_iter()
+            .with_min_len(GATE_PIECE)
+            .map(|sample| {
+                self.selections
+                    .iter()
+                    .position(|gate| !gate.keeps(sample, &context))
+            })
+            .collect();
+        let mut counts = vec![0; self.selections.len()];
+        for &g in removed_by.iter().flatten() {
+            counts[g] += 1;
+        }
+        let gates = self
+            .selections
+            .iter()
+            .zip(counts)
+            .map(|(gate, removed)| GateCount {
                 gate: *gate,
                 removed,
-            });
-        }
+            })
+            .collect();
         Ok(PreparedMeasurement {
             source: source.to_string(),
             measurement,

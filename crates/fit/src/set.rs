@@ -187,11 +187,11 @@ pub fn fit_set_with_data(
     // The energy and peak diagnostics follow the main fits there, while
     // the second fits may still run.
     // What the fitter reads of each input, made once for both fits.
-    let data = incidence_data(&inputs);
+    let mut data = incidence_data(&inputs);
     let (main, early) = rayon::join(
         || {
             let (reports, global) = fit_all(&data, &config, progress)?;
-            let adequacy = other_early.then(|| diagnose_all(&inputs, &reports, &config));
+            let adequacy = other_early.then(|| diagnose_all(&inputs, &data, &reports, &config));
             Ok::<_, FitSetError>((reports, global, adequacy))
         },
         || other_early.then(|| other_fits(&data, &config, progress)),
@@ -232,7 +232,8 @@ pub fn fit_set_with_data(
         };
         config.free_scale = false;
         progress.begin(fit_all_steps(inputs.len()) as u64);
-        let refit = fit_all(&incidence_data(&inputs), &config, progress);
+        data = incidence_data(&inputs);
+        let refit = fit_all(&data, &config, progress);
         progress.end();
         (reports, global) = refit?;
     }
@@ -242,12 +243,13 @@ pub fn fit_set_with_data(
             Some(others) => others,
             None => {
                 progress.begin(inputs.len() as u64);
-                let others = other_fits(&incidence_data(&inputs), &config, progress);
+                let others = other_fits(&data, &config, progress);
                 progress.end();
                 others
             }
         };
-        let adequacy = early_adequacy.unwrap_or_else(|| diagnose_all(&inputs, &reports, &config));
+        let adequacy =
+            early_adequacy.unwrap_or_else(|| diagnose_all(&inputs, &data, &reports, &config));
         assess(&mut reports, &config, adequacy, others);
     }
 
@@ -306,7 +308,12 @@ fn read_input(
         path: path.to_path_buf(),
         source,
     })?;
-    let sha256 = brtf_io::sha256_hex(&bytes);
+    // The file's digest is computed while it is read.
+    let klems_xml = brtf_gonio::detect_format(&bytes, path) == brtf_gonio::SourceFormat::KlemsXml;
+    let (sha256, measurement) = rayon::join(
+        || brtf_io::sha256_hex(&bytes),
+        || (!klems_xml).then(|| brtf_gonio::read_bytes(&bytes, path)),
+    );
     let source = path.display().to_string();
     let input = |prepared: PreparedMeasurement, samples, at| {
         let incidence = prepared.measurement.incidence;
@@ -323,7 +330,7 @@ fn read_input(
             prepared,
         }
     };
-    if brtf_gonio::detect_format(&bytes, path) == brtf_gonio::SourceFormat::KlemsXml {
+    let Some(measurement) = measurement else {
         let bsdf = brtf_gonio::klems::read_bytes(&bytes, path)?;
         let side = klems.side.unwrap_or(brtf_gonio::klems::Side::Front);
         let mut inputs = Vec::new();
@@ -342,8 +349,8 @@ fn read_input(
             inputs.push(input(prepared, samples, Some(at)));
         }
         return Ok(inputs);
-    }
-    let measurement = brtf_gonio::read_bytes(&bytes, path)?;
+    };
+    let measurement = measurement?;
     let samples = measurement.len();
     let prepared = recipe.prepare(measurement, &source)?;
     Ok(vec![input(prepared, samples, None)])
@@ -430,13 +437,15 @@ fn other_fits(
 /// [`diagnose::diagnose`]), in parallel.
 fn diagnose_all(
     inputs: &[Input],
+    data: &[IncidenceData],
     reports: &[FitReport],
     config: &FitConfig,
 ) -> Vec<Option<diagnose::Adequacy>> {
     inputs
         .par_iter()
+        .zip(data)
         .zip(reports)
-        .map(|(input, report)| diagnose::diagnose(&input.prepared, report, config))
+        .map(|((input, data), report)| diagnose::diagnose(&input.prepared, data, report, config))
         .collect()
 }
 
