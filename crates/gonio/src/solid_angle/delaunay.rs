@@ -150,6 +150,12 @@ fn triangulate_into(
         let into_next = if k == fan { NONE } else { 3 * (t + 1) };
         halfedges[base..base + 3].copy_from_slice(&[into_previous, NONE, into_next]);
     }
+    let mut triangle_of = vec![NONE; points.len()];
+    triangle_of[0] = 0;
+    for k in 1..=fan {
+        triangle_of[k as usize] = k - 1;
+        triangle_of[k as usize + 1] = k - 1;
+    }
     let mut inserter = Inserter {
         points,
         triangles,
@@ -157,6 +163,7 @@ fn triangulate_into(
         used: 3 * fan as usize,
         stack: Vec::with_capacity(64),
         last: 0,
+        triangle_of,
     };
     for &p in order {
         inserter.insert(p)?;
@@ -515,13 +522,30 @@ struct Inserter<'a> {
     used: usize,
     /// Halfedges waiting for the in-circle test.
     stack: Vec<u32>,
-    /// A triangle touching the previously inserted point: the walk's start.
+    /// A triangle touching the previously inserted point: the walk's start
+    /// when neither neighbour along the curve is in yet.
     last: u32,
+    /// Per point: a triangle touching it, or [`NONE`] until it is inserted.
+    triangle_of: Vec<u32>,
 }
 
 impl Inserter<'_> {
+    /// Inserts point `p`. The walk starts next to p's neighbour in the
+    /// spatial order (the points' indices) when that one is already in:
+    /// a step or two away, where the previous point of the same insertion
+    /// round is several.
     fn insert(&mut self, p: u32) -> Option<()> {
-        let t = self.locate(self.points[p as usize])?;
+        let i = p as usize;
+        let before = self.triangle_of[i - 1];
+        let after = self.triangle_of.get(i + 1).copied().unwrap_or(NONE);
+        let start = if before != NONE {
+            before
+        } else if after != NONE {
+            after
+        } else {
+            self.last
+        };
+        let t = self.locate(start, self.points[i])?;
         self.split(t, p);
         while let Some(e) = self.stack.pop() {
             self.legalize(e);
@@ -531,11 +555,11 @@ impl Inserter<'_> {
     }
 
     /// The triangle containing `point` (inside or on its boundary), by a
-    /// visibility walk from `self.last` that crosses any edge `point` lies
+    /// visibility walk from triangle `start` that crosses any edge `point` lies
     /// strictly beyond, trying the edges in turn after the one it came in by.
-    fn locate(&mut self, point: [f64; 2]) -> Option<u32> {
+    fn locate(&self, start: u32, point: [f64; 2]) -> Option<u32> {
         let (triangles, halfedges) = (&*self.triangles, &*self.halfedges);
-        let mut t = self.last;
+        let mut t = start;
         let mut entry = 0u32;
         // A Delaunay walk visits each triangle at most once.
         'walk: for _ in 0..=self.used / 3 {
@@ -583,6 +607,8 @@ impl Inserter<'_> {
         self.triangles[self.used..self.used + 6].copy_from_slice(&[b, c, p, c, a, p]);
         self.halfedges[self.used..self.used + 6].fill(NONE);
         self.used += 6;
+        self.triangle_of[c as usize] = t1;
+        self.triangle_of[p as usize] = t;
         // (a, b, p): a→b keeps its twin.
         self.link(3 * t + 1, 3 * t1 + 2); // b→p with p→b
         self.link(3 * t + 2, 3 * t2 + 1); // p→a with a→p
@@ -617,6 +643,8 @@ impl Inserter<'_> {
         let twin_b1 = self.halfedges[b1 as usize];
         self.triangles[a1 as usize] = d;
         self.triangles[b1 as usize] = p;
+        self.triangle_of[u as usize] = e / 3;
+        self.triangle_of[v as usize] = twin / 3;
         self.link(a0, twin_b1); // u→d
         self.link(b0, twin_a1); // v→p
         self.link(a1, b1); // d→p with p→d

@@ -210,10 +210,20 @@ fn ghost_ring() -> impl Iterator<Item = [f64; 2]> {
 }
 
 /// Disk-clipped Voronoi cell areas of the non-ghost vertices, in order, or
-/// `None` if a cell does not close (never seen: every such vertex is inside
-/// the ghost ring).
+/// `None` if one is not finite (never seen).
+///
+/// A vertex's cell is the polygon of the circumcentres of its triangles,
+/// and each of its edges is dual to one of the vertex's Delaunay edges.
+/// The clipped area is a sum over the polygon's edges (the signed area of
+/// the triangle from the origin to the edge, clipped to the disk), so it is
+/// summed edge by edge: each Delaunay edge u–v once, its term added to u's
+/// cell and subtracted from v's. These loads are independent, where walking
+/// around each vertex chases one pointer per corner. The edges are summed
+/// in a fixed number of parts, added in a fixed order, so the result does
+/// not depend on the thread count or scheduling.
 fn cell_areas(vertices: &[[f64; 2]], tri: &Triangulation) -> Option<Vec<f64>> {
-    let circumcenters: Vec<[f64; 2]> = tri
+    const PARTS: usize = 4;
+    let circumcentres: Vec<[f64; 2]> = tri
         .triangles
         .par_chunks_exact(3)
         .with_min_len(4096)
@@ -228,41 +238,44 @@ fn cell_areas(vertices: &[[f64; 2]], tri: &Triangulation) -> Option<Vec<f64>> {
             )
         })
         .collect();
-    // One halfedge ending at each vertex.
-    let mut incoming = vec![NONE; vertices.len()];
-    for e in 0..tri.triangles.len() as u32 {
-        let to = tri.triangles[delaunay::next(e) as usize];
-        if to != NONE {
-            incoming[to as usize] = e;
-        }
-    }
-    let steps = tri.triangles.len();
-    incoming[GHOSTS..]
-        .par_iter()
-        .with_min_len(2048)
-        .map_init(
-            || Vec::with_capacity(16),
-            |polygon: &mut Vec<[f64; 2]>, &start| {
-                if start == NONE {
-                    return None;
+    let triangle_slots = tri.triangles.len() / 3;
+    let per_part = triangle_slots.div_ceil(PARTS);
+    let r2 = DISK_RADIUS * DISK_RADIUS;
+    let parts: Vec<Vec<f64>> = (0..PARTS)
+        .into_par_iter()
+        .map(|part| {
+            let mut sums = vec![0.0; vertices.len()];
+            let slots = part * per_part..((part + 1) * per_part).min(triangle_slots);
+            for e in 3 * slots.start..3 * slots.end {
+                let twin = tri.halfedges[e];
+                // Each edge once; none on the hull (ghost to ghost) or in
+                // unused slots.
+                if twin == NONE || (twin as usize) < e || tri.triangles[e] == NONE {
+                    continue;
                 }
-                polygon.clear();
-                let mut e = start;
-                for _ in 0..steps {
-                    polygon.push(circumcenters[e as usize / 3]);
-                    let twin = tri.halfedges[delaunay::next(e) as usize];
-                    if twin == NONE {
-                        return None;
-                    }
-                    e = twin;
-                    if e == start {
-                        return Some(disk_polygon_area(polygon, DISK_RADIUS).abs());
-                    }
-                }
-                None
-            },
-        )
-        .collect()
+                let (u, v) = (
+                    tri.triangles[e],
+                    tri.triangles[delaunay::next(e as u32) as usize],
+                );
+                let (a, b) = (circumcentres[e / 3], circumcentres[twin as usize / 3]);
+                let inside = a[0] * a[0] + a[1] * a[1] <= r2 && b[0] * b[0] + b[1] * b[1] <= r2;
+                let area = if inside {
+                    0.5 * (a[0] * b[1] - a[1] * b[0])
+                } else {
+                    disk_triangle_area(a, b, DISK_RADIUS)
+                };
+                sums[u as usize] += area;
+                sums[v as usize] -= area;
+            }
+            sums
+        })
+        .collect();
+    let areas: Vec<f64> = (GHOSTS..vertices.len())
+        .into_par_iter()
+        .with_min_len(4096)
+        .map(|i| parts.iter().map(|sums| sums[i]).sum::<f64>().abs())
+        .collect();
+    areas.iter().all(|a| a.is_finite()).then_some(areas)
 }
 
 /// Areas of the Voronoi cells of `points` clipped to the disk of radius
