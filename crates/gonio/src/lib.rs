@@ -63,7 +63,7 @@ pub use measurement::{
 };
 pub use read::{
     detect_format, incidence_from_file_name, is_xml, read_bytes, read_bytes_as, read_path,
-    read_path_as, read_sample_name, read_str,
+    read_path_as, read_sample_name, read_sample_name_at, read_str,
 };
 pub use select::{DEFAULT_THETA_CAP_DEG, Gate, GateContext, PGII_HOLDER_BAND, Selection};
 pub use solid_angle::{SolidAngleSource, SolidAngles, compute_solid_angles, solid_angles};

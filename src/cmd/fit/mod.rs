@@ -206,9 +206,8 @@ fn default_name(files: &[PathBuf], klems: bool) -> Result<String> {
                 .name
         } else {
             // The header alone: the fit reads and checks the whole file.
-            let bytes =
-                std::fs::read(file).with_context(|| format!("cannot read {}", file.display()))?;
-            brtf_gonio::read_sample_name(&bytes, file)
+            brtf_gonio::read_sample_name_at(file)
+                .with_context(|| format!("cannot read {}", file.display()))?
         };
         sample_names.push(name);
     }

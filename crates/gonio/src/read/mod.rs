@@ -85,9 +85,38 @@ pub fn read_sample_name(bytes: &[u8], name: impl AsRef<Path>) -> Option<String> 
         return None;
     }
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
-    // The header ends with the LF-ended piece that holds the first data
-    // row (a line that is neither blank nor a `#` comment); a lone-CR
-    // file is one piece, read whole.
+    let end = header_end(bytes).unwrap_or(bytes.len());
+    mountain::header_sample_name(&text::decode(&bytes[..end]))
+}
+
+/// [`read_sample_name`] of the file at `path`, reading only as much of it
+/// as holds the header (and the first data row, which may decide the
+/// format).
+pub fn read_sample_name_at(path: impl AsRef<Path>) -> std::io::Result<Option<String>> {
+    use std::io::Read;
+    let path = path.as_ref();
+    let mut file = std::fs::File::open(path)?;
+    let mut bytes = Vec::new();
+    let mut want = 64 * 1024;
+    loop {
+        let before = bytes.len();
+        (&mut file)
+            .take((want - before) as u64)
+            .read_to_end(&mut bytes)?;
+        let at_end = bytes.len() < want;
+        let body = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(&bytes);
+        // A prefix will do once its header ends with a whole line.
+        if at_end || header_end(body).is_some_and(|end| body[..end].ends_with(b"\n")) {
+            return Ok(read_sample_name(&bytes, path));
+        }
+        want *= 4;
+    }
+}
+
+/// Where the header of a Mountain file's text ends: after the LF-ended
+/// piece that holds the first data row (a line that is neither blank nor
+/// a `#` comment); `None` without a data row. A lone-CR file is one piece.
+fn header_end(bytes: &[u8]) -> Option<usize> {
     let mut end = 0;
     for piece in bytes.split_inclusive(|&b| b == b'\n') {
         end += piece.len();
@@ -96,10 +125,10 @@ pub fn read_sample_name(bytes: &[u8], name: impl AsRef<Path>) -> Option<String> 
             .map(<[u8]>::trim_ascii)
             .any(|line| !line.is_empty() && !line.starts_with(b"#"));
         if data_row {
-            break;
+            return Some(end);
         }
     }
-    mountain::header_sample_name(&text::decode(&bytes[..end]))
+    None
 }
 
 /// Guesses the format: a `.mpc` extension; else the header (a `#format:`
@@ -537,7 +566,42 @@ mod tests {
             let bytes = std::fs::read(&path).unwrap();
             let whole = read_bytes(&bytes, &path).unwrap().sample_name;
             assert_eq!(read_sample_name(&bytes, &path), whole, "{}", path.display());
+            assert_eq!(
+                read_sample_name_at(&path).unwrap(),
+                whole,
+                "{}",
+                path.display()
+            );
         }
+        // A header longer than the first read, its name at the end, and a
+        // file that is all header.
+        let dir = std::env::temp_dir().join(format!("brtf-name-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let long = format!(
+            "#intheta 30\n#inphi 0\n{}#sample_name late\n10 0 0.5\n20 0 0.25\n",
+            "# a long comment line of the header, repeated\n".repeat(6000)
+        );
+        for (file, text, want) in [
+            ("long.txt", long.clone(), Some("late")),
+            (
+                "header.txt",
+                long[..long.len() - 20].to_string(),
+                Some("late"),
+            ),
+            (
+                "short.txt",
+                "#sample_name s\n1 2 3\n".to_string(),
+                Some("s"),
+            ),
+        ] {
+            let path = dir.join(file);
+            std::fs::write(&path, &text).unwrap();
+            let got = read_sample_name_at(&path).unwrap();
+            assert_eq!(got, read_sample_name(text.as_bytes(), &path), "{file}");
+            assert_eq!(got.as_deref(), want, "{file}");
+        }
+        assert!(read_sample_name_at(dir.join("missing.txt")).is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
         let head = "#intheta 30\n#inphi 0\n#format: theta phi BSDF\n";
         let rows = "10 0 0.5\n20 0 0.25\n";
         let variants: Vec<Vec<u8>> = vec![
