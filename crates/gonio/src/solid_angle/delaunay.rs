@@ -34,6 +34,10 @@ pub(crate) struct Triangulation {
     pub triangles: Vec<u32>,
     /// The twin of each halfedge, or [`NONE`].
     pub halfedges: Vec<u32>,
+    /// Empty, or the circumcentre of each triangle slot as
+    /// [`circumcentre`] gives it from the stored vertices (anything for
+    /// unused slots).
+    pub circumcentres: Vec<[f64; 2]>,
 }
 
 /// The halfedge after `e` in its triangle.
@@ -112,6 +116,7 @@ pub(crate) fn triangulate_in_polygon(
     Some(Triangulation {
         triangles,
         halfedges,
+        circumcentres: Vec::new(),
     })
 }
 
@@ -231,6 +236,7 @@ fn triangulate_half(
     left: bool,
     triangles: &mut [u32],
     halfedges: &mut [u32],
+    centres: &mut [[f64; 2]],
     offset: u32,
 ) -> Option<Half> {
     let order: Vec<u32> = brio_order(members.len())
@@ -242,14 +248,16 @@ fn triangulate_half(
     let beyond = |x: f64| if left { split - x } else { x - split };
     let kept: Vec<bool> = triangles
         .chunks_exact(3)
-        .map(|t| {
+        .zip(centres.iter_mut())
+        .map(|(t, centre)| {
             let [a, b, c] = [t[0], t[1], t[2]].map(|i| points[i as usize]);
             if !(beyond(a[0]) > 0.0 && beyond(b[0]) > 0.0 && beyond(c[0]) > 0.0) {
                 return false;
             }
             // The circle clear of the line, with a margin for rounding (a
-            // wrong call here is caught by the merge's checks).
-            let centre = circumcentre(a, b, c);
+            // wrong call here is caught by the merge's checks). The centre
+            // is kept for the Voronoi cells.
+            *centre = circumcentre(a, b, c);
             let radius2 = (centre[0] - a[0]).powi(2) + (centre[1] - a[1]).powi(2);
             let gap = beyond(centre[0]);
             gap > 0.0 && gap * gap > radius2 * (1.0 + 1e-9)
@@ -354,19 +362,22 @@ pub(crate) fn triangulate_in_polygon_split(
     let slots_all = 3 * triangle_count(corners, points.len() - corners);
     let mut triangles = vec![0u32; slots_a + slots_b + slots_all];
     let mut halfedges = vec![0u32; slots_a + slots_b + slots_all];
+    let mut centres = vec![[0.0; 2]; (slots_a + slots_b + slots_all) / 3];
     triangles.truncate(slots_a + slots_b);
     halfedges.truncate(slots_a + slots_b);
+    centres.truncate((slots_a + slots_b) / 3);
     let (a, b) = {
         let (triangles_a, triangles_b) = triangles.split_at_mut(slots_a);
         let (halfedges_a, halfedges_b) = halfedges.split_at_mut(slots_a);
+        let (centres_a, centres_b) = centres.split_at_mut(slots_a / 3);
         rayon::join(
             || {
-                let (t, h) = (triangles_a, halfedges_a);
-                triangulate_half(points, corners, &left, split, true, t, h, 0)
+                let (t, h, c) = (triangles_a, halfedges_a, centres_a);
+                triangulate_half(points, corners, &left, split, true, t, h, c, 0)
             },
             || {
-                let (t, h, offset) = (triangles_b, halfedges_b, slots_a as u32);
-                triangulate_half(points, corners, &right, split, false, t, h, offset)
+                let (t, h, c, offset) = (triangles_b, halfedges_b, centres_b, slots_a as u32);
+                triangulate_half(points, corners, &right, split, false, t, h, c, offset)
             },
         )
     };
@@ -445,6 +456,8 @@ pub(crate) fn triangulate_in_polygon_split(
     let first = triangles.len() as u32;
     let merged = |g: u32| first + 3 * new_index[g as usize / 3] + g % 3;
     for &t in &inside {
+        let v = &gap.triangles[3 * t as usize..3 * t as usize + 3];
+        centres.push(circumcentre(pt(v[0]), pt(v[1]), pt(v[2])));
         for g in 3 * t..3 * t + 3 {
             triangles.push(gap.triangles[g as usize]);
             let p = partner[g as usize];
@@ -466,6 +479,7 @@ pub(crate) fn triangulate_in_polygon_split(
     Some(Triangulation {
         triangles,
         halfedges,
+        circumcentres: centres,
     })
 }
 

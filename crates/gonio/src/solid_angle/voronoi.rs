@@ -223,21 +223,27 @@ fn ghost_ring() -> impl Iterator<Item = [f64; 2]> {
 /// not depend on the thread count or scheduling.
 fn cell_areas(vertices: &[[f64; 2]], tri: &Triangulation) -> Option<Vec<f64>> {
     const PARTS: usize = 4;
-    let circumcentres: Vec<[f64; 2]> = tri
-        .triangles
-        .par_chunks_exact(3)
-        .with_min_len(4096)
-        .map(|t| {
-            if t[0] == NONE {
-                return [f64::NAN; 2]; // an unused slot
-            }
-            circumcentre(
-                vertices[t[0] as usize],
-                vertices[t[1] as usize],
-                vertices[t[2] as usize],
-            )
-        })
-        .collect();
+    let computed: Vec<[f64; 2]>;
+    let circumcentres = if tri.circumcentres.len() == tri.triangles.len() / 3 {
+        &tri.circumcentres
+    } else {
+        computed = tri
+            .triangles
+            .par_chunks_exact(3)
+            .with_min_len(4096)
+            .map(|t| {
+                if t[0] == NONE {
+                    return [f64::NAN; 2]; // an unused slot
+                }
+                circumcentre(
+                    vertices[t[0] as usize],
+                    vertices[t[1] as usize],
+                    vertices[t[2] as usize],
+                )
+            })
+            .collect();
+        &computed
+    };
     let triangle_slots = tri.triangles.len() / 3;
     let per_part = triangle_slots.div_ceil(PARTS);
     let r2 = DISK_RADIUS * DISK_RADIUS;
