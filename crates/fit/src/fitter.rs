@@ -57,58 +57,71 @@ pub fn fit_global(data: &[IncidenceData], config: &FitConfig) -> Result<FitRepor
     fit_many(data, config, "all incidences", None)
 }
 
-/// The pair geometry of each of `data`'s incidences, for a fit set whose
-/// per-incidence and all-incidence fits share it: `None` when the data
-/// are not patch averages, or when their pairs exceed the cache budget.
-pub(crate) fn shared_pair_geometry(
-    data: &[IncidenceData],
-    config: &FitConfig,
-) -> Result<Option<Vec<PairGeometry>>, FitError> {
-    let pairs: Option<Vec<&PatchPairs>> = data.iter().map(|d| d.patch_pairs.as_deref()).collect();
-    let Some(pairs) = pairs else {
-        return Ok(None);
-    };
-    let total: usize = pairs.iter().map(|p| p.pair_count()).sum();
-    if total == 0 || total > GEOMETRY_CACHE_PAIRS {
-        return Ok(None);
-    }
-    let bsdf = geometry_bsdf(config)?;
-    Ok(Some(
-        pairs
-            .par_iter()
-            .map(|p| PairGeometry::new(p, &bsdf))
-            .collect(),
-    ))
+/// The argument-free geometry of one incidence's block, computed once and
+/// shared by every fit of a fit set that uses it (the per-incidence fit,
+/// the all-incidence fit and the adequacy diagnostics' second fit).
+pub(crate) enum SharedGeometry {
+    /// Patch-averaged data: their pairs' geometry.
+    Pairs(PairGeometry),
+    /// Measured data: each sample's geometry.
+    Samples(GeometryBatch),
+    /// Nothing kept (pairs beyond the memory budget): the kernel computes
+    /// the geometry on every pass.
+    None,
 }
 
-/// [`fit_incidence`] with the incidence's shared pair geometry.
+/// The geometry of each of `data`'s incidences (see [`SharedGeometry`]).
+/// Patch pairs are kept only within the cache budget, for all incidences
+/// or none.
+pub(crate) fn shared_geometry(
+    data: &[IncidenceData],
+    config: &FitConfig,
+) -> Result<Vec<SharedGeometry>, FitError> {
+    let bsdf = geometry_bsdf(config)?;
+    let total_pairs: usize = data
+        .iter()
+        .filter_map(|d| d.patch_pairs.as_deref())
+        .map(PatchPairs::pair_count)
+        .sum();
+    let keep_pairs = total_pairs <= GEOMETRY_CACHE_PAIRS;
+    Ok(data
+        .par_iter()
+        .map(|d| match d.patch_pairs.as_deref() {
+            Some(pairs) if keep_pairs => SharedGeometry::Pairs(PairGeometry::new(pairs, &bsdf)),
+            Some(_) => SharedGeometry::None,
+            None => SharedGeometry::Samples(sample_geometry(&bsdf, d.light(), &d.samples)),
+        })
+        .collect())
+}
+
+/// [`fit_incidence`] with the incidence's shared geometry.
 pub(crate) fn fit_incidence_sharing(
     data: &IncidenceData,
     config: &FitConfig,
-    geometry: Option<&PairGeometry>,
+    geometry: &SharedGeometry,
 ) -> Result<FitReport, FitError> {
     fit_many(
         std::slice::from_ref(data),
         config,
         &data.source,
-        geometry.map(std::slice::from_ref),
+        Some(std::slice::from_ref(geometry)),
     )
 }
 
-/// [`fit_global`] with the incidences' shared pair geometry.
+/// [`fit_global`] with the incidences' shared geometry.
 pub(crate) fn fit_global_sharing(
     data: &[IncidenceData],
     config: &FitConfig,
-    geometry: Option<&[PairGeometry]>,
+    geometry: &[SharedGeometry],
 ) -> Result<FitReport, FitError> {
-    fit_many(data, config, "all incidences", geometry)
+    fit_many(data, config, "all incidences", Some(geometry))
 }
 
 fn fit_many(
     data: &[IncidenceData],
     config: &FitConfig,
     label: &str,
-    geometry: Option<&[PairGeometry]>,
+    geometry: Option<&[SharedGeometry]>,
 ) -> Result<FitReport, FitError> {
     let started = Instant::now();
     let channels = data[0].channels.clamp(1, 3);
@@ -118,27 +131,22 @@ fn fit_many(
     let gray = config.gray || channels == 1;
     let map = ParamMap::new(config.kind, gray, config.free_scale)
         .with_min_roughness(config.min_roughness);
-    // Patch-averaged blocks get their pairs' geometry once per fit (or
-    // the fit set's shared one), unless it would take too much memory.
+    // The blocks' geometry once per fit, or the fit set's shared one.
     let own_geometry = match geometry {
         Some(_) => None,
-        None => shared_pair_geometry(data, config)?,
+        None => Some(shared_geometry(data, config)?),
     };
-    let geometry = geometry.or(own_geometry.as_deref());
+    let geometry = geometry.or(own_geometry.as_deref()).unwrap_or_default();
     let mut blocks = Vec::with_capacity(data.len());
     let mut stats = Vec::with_capacity(data.len());
-    // Measured samples get their geometry once per fit.
-    let sample_bsdf = if data.iter().any(|d| d.patch_pairs.is_none()) {
-        Some(geometry_bsdf(config)?)
-    } else {
-        None
-    };
     for (k, d) in data.iter().enumerate() {
         let mut scan = prepare::scan(d, channels, config)?;
-        scan.block.pair_geometry = geometry.map(|g| Cow::Borrowed(&g[k]));
-        if let (None, Some(bsdf)) = (&scan.block.pairs, &sample_bsdf) {
-            let geometry = sample_geometry(bsdf, scan.block.light, &scan.block.samples);
-            scan.block.sample_geometry = Some(Cow::Owned(geometry));
+        match geometry.get(k) {
+            Some(SharedGeometry::Pairs(g)) => scan.block.pair_geometry = Some(Cow::Borrowed(g)),
+            Some(SharedGeometry::Samples(g)) => {
+                scan.block.sample_geometry = Some(Cow::Borrowed(g));
+            }
+            Some(SharedGeometry::None) | None => {}
         }
         blocks.push(scan.block);
         stats.push(scan.stats);
@@ -338,7 +346,9 @@ fn sample_geometry(bsdf: &Bsdf, light: DVec3, samples: &[FitSample]) -> Geometry
     } else {
         vec![piece(samples)]
     };
-    pieces.into_iter().flatten().collect()
+    let mut batch = GeometryBatch::with_capacity(samples.len());
+    batch.extend(pieces.into_iter().flatten());
+    batch
 }
 
 /// A BSDF of the fit's type, orientation and options, for pair geometry:

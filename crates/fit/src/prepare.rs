@@ -7,6 +7,7 @@ use crate::config::{FitConfig, FitError};
 use crate::data::{FitSample, IncidenceData};
 use crate::params::{MIN_ROUGHNESS, ParamMap, Target};
 use crate::problem::Block;
+use brtf_model::GeometryBatch;
 use glam::DVec3;
 use nalgebra::DVector;
 use rayon::prelude::*;
@@ -267,10 +268,11 @@ pub(crate) fn subsample<'a>(b: &Block<'_>, target: usize, bright: f64) -> Block<
             .pair_geometry
             .as_ref()
             .map(|g| Cow::Owned(g.select(kept.iter().copied()))),
-        sample_geometry: b
-            .sample_geometry
-            .as_ref()
-            .map(|g| Cow::Owned(kept.iter().map(|&i| g.get(i)).collect())),
+        sample_geometry: b.sample_geometry.as_ref().map(|g| {
+            let mut selected = GeometryBatch::with_capacity(kept.len());
+            selected.extend(kept.iter().map(|&i| g.get(i)));
+            Cow::Owned(selected)
+        }),
         weight_scale: b.weight_scale,
         unit_weights: b.unit_weights,
         multipliers: Some(multipliers),

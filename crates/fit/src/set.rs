@@ -5,9 +5,7 @@
 use crate::config::{FitConfig, FitError};
 use crate::data::IncidenceData;
 use crate::diagnose;
-use crate::fitter::{
-    fit_global_sharing, fit_incidence, fit_incidence_sharing, shared_pair_geometry,
-};
+use crate::fitter::{SharedGeometry, fit_global_sharing, fit_incidence_sharing, shared_geometry};
 use crate::recipe::{PreparedMeasurement, Recipe, RecipeError, ScaleRule};
 use crate::report::FitReport;
 use crate::result::{FIT_JSON_SCHEMA, FitResult, InputFile, Provenance, SetWarning};
@@ -188,13 +186,15 @@ pub fn fit_set_with_data(
     // the second fits may still run.
     // What the fitter reads of each input, made once for both fits.
     let mut data = incidence_data(&inputs);
+    // So is the geometry, which a rescale of the values leaves as it is.
+    let geometry = shared_geometry(&data, &config)?;
     let (main, early) = rayon::join(
         || {
-            let (reports, global) = fit_all(&data, &config, progress)?;
+            let (reports, global) = fit_all(&data, &geometry, &config, progress)?;
             let adequacy = other_early.then(|| diagnose_all(&inputs, &data, &reports, &config));
             Ok::<_, FitSetError>((reports, global, adequacy))
         },
-        || other_early.then(|| other_fits(&data, &config, progress)),
+        || other_early.then(|| other_fits(&data, &geometry, &config, progress)),
     );
     progress.end();
     let (mut reports, mut global, early_adequacy) = main?;
@@ -233,7 +233,7 @@ pub fn fit_set_with_data(
         config.free_scale = false;
         progress.begin(fit_all_steps(inputs.len()) as u64);
         data = incidence_data(&inputs);
-        let refit = fit_all(&data, &config, progress);
+        let refit = fit_all(&data, &geometry, &config, progress);
         progress.end();
         (reports, global) = refit?;
     }
@@ -243,7 +243,7 @@ pub fn fit_set_with_data(
             Some(others) => others,
             None => {
                 progress.begin(inputs.len() as u64);
-                let others = other_fits(&data, &config, progress);
+                let others = other_fits(&data, &geometry, &config, progress);
                 progress.end();
                 others
             }
@@ -418,6 +418,7 @@ fn instrument_scale(
 /// diagnostics' second fit. `None` where that fit fails.
 fn other_fits(
     data: &[IncidenceData],
+    geometry: &[SharedGeometry],
     config: &FitConfig,
     progress: &dyn Progress,
 ) -> Vec<Option<FitReport>> {
@@ -425,8 +426,9 @@ fn other_fits(
     other_config.residual = diagnose::other_residual(config.residual);
     other_config.loss = crate::RobustLoss::None;
     data.par_iter()
-        .map(|d| {
-            let r = fit_incidence(d, &other_config).ok();
+        .zip(geometry)
+        .map(|(d, g)| {
+            let r = fit_incidence_sharing(d, &other_config, g).ok();
             progress.advance();
             r
         })
@@ -488,18 +490,16 @@ fn fit_all_steps(incidences: usize) -> usize {
 /// begins and ends the progress ([`fit_all_steps`] steps).
 fn fit_all(
     data: &[IncidenceData],
+    geometry: &[SharedGeometry],
     config: &FitConfig,
     progress: &dyn Progress,
 ) -> Result<(Vec<FitReport>, FitReport), FitSetError> {
-    // Patch pairs' geometry is computed once for both fits of each incidence.
-    let geometry = shared_pair_geometry(data, config)?;
-    let geometry = geometry.as_deref();
     let (reports, global) = rayon::join(
         || {
             data.par_iter()
                 .enumerate()
                 .map(|(i, d)| {
-                    let r = fit_incidence_sharing(d, config, geometry.map(|g| &g[i]));
+                    let r = fit_incidence_sharing(d, config, &geometry[i]);
                     progress.advance();
                     r
                 })

@@ -77,6 +77,20 @@ impl GeometryBatch {
         }
     }
 
+    /// Room for `n` more pairs.
+    pub fn reserve(&mut self, n: usize) {
+        for column in [
+            &mut self.light_cosine,
+            &mut self.view_cosine,
+            &mut self.lobe_factor,
+            &mut self.x_u,
+            &mut self.x_v,
+            &mut self.cutoff_factor,
+        ] {
+            column.reserve(n);
+        }
+    }
+
     /// Appends one pair's geometry.
     #[inline]
     pub fn push(&mut self, g: Geometry) {
@@ -147,6 +161,8 @@ impl GeometryBatch {
 
 impl Extend<Geometry> for GeometryBatch {
     fn extend<I: IntoIterator<Item = Geometry>>(&mut self, iter: I) {
+        let iter = iter.into_iter();
+        self.reserve(iter.size_hint().0);
         for g in iter {
             self.push(g);
         }
