@@ -50,7 +50,6 @@ pub use error::PlotError;
 pub use klems::klems_sides_report;
 
 use brtf_fit::{FitResult, PreparedMeasurement};
-use brtf_gonio::Hemisphere;
 use charts::azimuth::AzimuthChart;
 use charts::cut::{CutChart, CutsChart};
 use charts::map::MapChart;
@@ -157,23 +156,12 @@ impl Job<'_> {
             Job::Rms(c) => render_files(c, dir),
         }
     }
-
-    /// The chart draws the nearest-sample grids ([`Incidence::coverage`]).
-    fn needs_coverage(&self) -> bool {
-        matches!(self, Job::Map(_) | Job::Rho(_))
-    }
 }
 
 /// Renders every job and writes its files; returns the paths in `jobs` order.
-/// The nearest-sample grids of `incs` are made at the same time as the
-/// charts that do not need them, so both cores stay busy; the charts
-/// that do need them follow. The files are written by a thread of their
-/// own, so that rendering never waits for the disk (each write syncs).
-fn render_and_write(
-    jobs: &[Job],
-    incs: &[&Incidence],
-    dir: &Path,
-) -> Result<Vec<PathBuf>, PlotError> {
+/// The files are written by a thread of their own, so that rendering never
+/// waits for the disk (each write syncs).
+fn render_and_write(jobs: &[Job], dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
     std::thread::scope(|scope| {
         let (send, receive) = std::sync::mpsc::channel::<(PathBuf, Vec<u8>)>();
         let writer = scope.spawn(move || {
@@ -195,26 +183,11 @@ fn render_and_write(
             }
             Ok(paths)
         };
-        let phase = |grids: bool| -> Vec<(usize, Result<Vec<PathBuf>, PlotError>)> {
-            jobs.par_iter()
-                .enumerate()
-                .filter(|(_, j)| j.needs_coverage() == grids)
-                .map(|(k, j)| (k, render(j)))
-                .collect()
-        };
-        let (mut rendered, ()) = rayon::join(
-            || phase(false),
-            || {
-                incs.par_iter().for_each(|inc| {
-                    [Hemisphere::Front, Hemisphere::Back]
-                        .par_iter()
-                        .for_each(|h| {
-                            inc.coverage(*h);
-                        })
-                })
-            },
-        );
-        rendered.extend(phase(true));
+        let mut rendered: Vec<(usize, Result<Vec<PathBuf>, PlotError>)> = jobs
+            .par_iter()
+            .enumerate()
+            .map(|(k, j)| (k, render(j)))
+            .collect();
         drop(send);
         let written = writer
             .join()
@@ -398,7 +371,7 @@ fn plot(
         jobs.push(Job::Cuts(cuts));
     }
 
-    let mut files = render_and_write(&jobs, &incs, &plots)?;
+    let mut files = render_and_write(&jobs, &plots)?;
     remove_stale(&plots, &files);
 
     let entries = result

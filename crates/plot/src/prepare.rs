@@ -88,7 +88,8 @@ pub struct Incidence {
     pub channels: usize,
     /// Things the reader should know about this incidence's plots.
     pub warnings: Vec<String>,
-    /// Nearest-sample grids of the front and back disks, made when first needed.
+    /// Nearest-sample grids of the front and back disks, made with the
+    /// samples (at the same time as the model).
     coverage: [OnceLock<Coverage>; 2],
     /// The samples near the plane of incidence, for the cuts.
     near_plane: OnceLock<Vec<(f64, f64, usize)>>,
@@ -113,27 +114,20 @@ pub struct CutCache {
 
 impl Incidence {
     /// Every pixel of the `hemisphere`'s equal-area disk and the sample
-    /// that owns it (fitted or not; an index into `samples`), computed on
-    /// first use. The maps draw it, the hemispherical integrals sum over it.
+    /// that owns it (fitted or not; an index into `samples`), made when
+    /// the incidence is built. The maps draw it, the hemispherical
+    /// integrals sum over it.
     pub fn coverage(&self, hemisphere: Hemisphere) -> &Coverage {
         let slot = match hemisphere {
             Hemisphere::Front => 0,
             Hemisphere::Back => 1,
         };
         self.coverage[slot].get_or_init(|| {
-            let (ids, points): (Vec<u32>, Vec<(f64, f64)>) = self
-                .samples
-                .iter()
-                .enumerate()
-                .filter(|(_, s)| s.hemisphere() == hemisphere && s.dir.is_finite())
-                .filter(|(_, s)| !s.used() || s.data.is_finite())
-                .map(|(k, s)| (k as u32, disk::project(s.dir, hemisphere)))
-                .unzip();
-            Coverage::new(
-                &points,
-                &ids,
-                disk::COVERAGE_SIZE,
-                disk::radius_of(disk::FILL_DEG),
+            disk_grid(
+                hemisphere,
+                self.samples
+                    .iter()
+                    .map(|s| (s.theta, s.dir, s.used(), s.data)),
             )
         })
     }
@@ -210,6 +204,30 @@ impl Incidence {
     pub fn log_ratio(&self, s: &PlotSample) -> f64 {
         s.log_ratio
     }
+}
+
+/// The nearest-sample grid of one hemisphere over samples given as
+/// `(θ_out in degrees, direction, fitted, data)`: every sample of that
+/// hemisphere with a finite direction, except fitted ones without data.
+/// Owners are positions in the sequence.
+fn disk_grid(
+    hemisphere: Hemisphere,
+    samples: impl Iterator<Item = (f64, DVec3, bool, f64)>,
+) -> Coverage {
+    let (ids, points): (Vec<u32>, Vec<(f64, f64)>) = samples
+        .enumerate()
+        .filter(|(_, (theta, dir, _, _))| {
+            Hemisphere::of_theta(*theta) == hemisphere && dir.is_finite()
+        })
+        .filter(|(_, (_, _, used, data))| !used || data.is_finite())
+        .map(|(k, (_, dir, _, _))| (k as u32, disk::project(dir, hemisphere)))
+        .unzip();
+    Coverage::new(
+        &points,
+        &ids,
+        disk::COVERAGE_SIZE,
+        disk::radius_of(disk::FILL_DEG),
+    )
 }
 
 /// `ln((model + floor)/(data + floor))`, data clamped at 0.
@@ -296,77 +314,106 @@ fn build(
     // squared relative errors of the fitted ones (per channel) are summed
     // afterwards in sample order.
     const BLOCK: usize = 4096;
-    let blocks: Vec<Vec<(PlotSample, Option<[f64; 3]>)>> = m
+    let dirs: Vec<DVec3> = m
         .samples
-        .par_chunks(BLOCK)
-        .zip(removed_by.par_chunks(BLOCK))
-        .enumerate()
-        .map(|(b, (block, removed))| {
-            let dirs: Vec<DVec3> = block.iter().map(|s| s.direction()).collect();
-            // Patch-averaged (Klems) data are compared with the averaged
-            // model ([`PreparedMeasurement::model_value`]); else the model
-            // is the BSDF at each direction, evaluated for the whole block
-            // at once (brtf-model's batch kernel, equal to `Bsdf::eval` to
-            // about 1e-15).
-            let mut values = brtf_model::RgbBatch::default();
-            match prepared.patch_pairs {
-                Some(_) => {
-                    values.resize(0);
-                    for k in 0..block.len() {
-                        let f = prepared.model_value(&bsdf, b * BLOCK + k);
-                        values.r.push(f[0]);
-                        values.g.push(f[1]);
-                        values.b.push(f[2]);
-                    }
-                }
-                None => {
-                    let n = block.len();
-                    let light = brtf_model::Directions {
-                        x: vec![incident.x; n],
-                        y: vec![incident.y; n],
-                        z: vec![incident.z; n],
-                    };
-                    bsdf.eval_batch(
-                        &light,
-                        &brtf_model::Directions::from_vectors(&dirs),
-                        &mut values,
-                    );
-                }
-            }
-            block
-                .iter()
-                .zip(removed)
-                .zip(dirs)
-                .enumerate()
-                .map(|(k, ((s, removed), dir))| {
-                    let f = values.get(k);
-                    let mut data = 0.0;
-                    let mut model = 0.0;
-                    let mut rel = [0.0; 3];
-                    for (c, (&y, &fc)) in s.values.iter().zip(&f).take(channels).enumerate() {
-                        let mv = report.scale * fc;
-                        if removed.is_none() {
-                            let e = mv - y;
-                            rel[c] = e * e / (y * y + floor2);
-                        }
-                        data += y;
-                        model += mv;
-                    }
-                    let (data, model) = (data / channels as f64, model / channels as f64);
-                    let sample = PlotSample {
-                        theta: s.theta_deg,
-                        phi: s.phi_deg,
-                        dir,
-                        data,
-                        model,
-                        removed_by: *removed,
-                        log_ratio: log_ratio(data, model, floor),
-                    };
-                    (sample, removed.is_none().then_some(rel))
-                })
-                .collect()
-        })
+        .par_iter()
+        .with_min_len(BLOCK)
+        .map(|s| s.direction())
         .collect();
+    let samples_with_model = || -> Vec<Vec<(PlotSample, Option<[f64; 3]>)>> {
+        m.samples
+            .par_chunks(BLOCK)
+            .zip(removed_by.par_chunks(BLOCK))
+            .zip(dirs.par_chunks(BLOCK))
+            .enumerate()
+            .map(|(b, ((block, removed), dirs))| {
+                // Patch-averaged (Klems) data are compared with the averaged
+                // model ([`PreparedMeasurement::model_value`]); else the model
+                // is the BSDF at each direction, evaluated for the whole block
+                // at once (brtf-model's batch kernel, equal to `Bsdf::eval` to
+                // about 1e-15).
+                let mut values = brtf_model::RgbBatch::default();
+                match prepared.patch_pairs {
+                    Some(_) => {
+                        values.resize(0);
+                        for k in 0..block.len() {
+                            let f = prepared.model_value(&bsdf, b * BLOCK + k);
+                            values.r.push(f[0]);
+                            values.g.push(f[1]);
+                            values.b.push(f[2]);
+                        }
+                    }
+                    None => {
+                        let n = block.len();
+                        let light = brtf_model::Directions {
+                            x: vec![incident.x; n],
+                            y: vec![incident.y; n],
+                            z: vec![incident.z; n],
+                        };
+                        bsdf.eval_batch(
+                            &light,
+                            &brtf_model::Directions::from_vectors(dirs),
+                            &mut values,
+                        );
+                    }
+                }
+                block
+                    .iter()
+                    .zip(removed)
+                    .zip(dirs)
+                    .enumerate()
+                    .map(|(k, ((s, removed), dir))| {
+                        let f = values.get(k);
+                        let mut data = 0.0;
+                        let mut model = 0.0;
+                        let mut rel = [0.0; 3];
+                        for (c, (&y, &fc)) in s.values.iter().zip(&f).take(channels).enumerate() {
+                            let mv = report.scale * fc;
+                            if removed.is_none() {
+                                let e = mv - y;
+                                rel[c] = e * e / (y * y + floor2);
+                            }
+                            data += y;
+                            model += mv;
+                        }
+                        let (data, model) = (data / channels as f64, model / channels as f64);
+                        let sample = PlotSample {
+                            theta: s.theta_deg,
+                            phi: s.phi_deg,
+                            dir: *dir,
+                            data,
+                            model,
+                            removed_by: *removed,
+                            log_ratio: log_ratio(data, model, floor),
+                        };
+                        (sample, removed.is_none().then_some(rel))
+                    })
+                    .collect()
+            })
+            .collect()
+    };
+    // The nearest-sample grids need only the directions and the data, not
+    // the model: made at the same time as the model, they are ready when
+    // the charts start.
+    let grid_of = |hemisphere: Hemisphere| {
+        disk_grid(
+            hemisphere,
+            m.samples
+                .iter()
+                .zip(removed_by)
+                .zip(&dirs)
+                .map(|((s, removed), dir)| {
+                    let mut data = 0.0;
+                    for y in s.values.iter().take(channels) {
+                        data += y;
+                    }
+                    (s.theta_deg, *dir, removed.is_none(), data / channels as f64)
+                }),
+        )
+    };
+    let (blocks, (front, back)) = rayon::join(samples_with_model, || {
+        rayon::join(|| grid_of(Hemisphere::Front), || grid_of(Hemisphere::Back))
+    });
     let rows = blocks.into_iter().flatten();
     let mut sum_rel = 0.0;
     let mut n_used = 0usize;
@@ -416,7 +463,7 @@ fn build(
         scale: report.scale,
         channels,
         warnings,
-        coverage: Default::default(),
+        coverage: [OnceLock::from(front), OnceLock::from(back)],
         near_plane: OnceLock::new(),
         cut: OnceLock::new(),
     };
