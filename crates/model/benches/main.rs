@@ -3,7 +3,7 @@
 
 use brtf_model::{
     Bsdf, Directions, EvalOptions, Geometry, GeometryBatch, Gradient, Material, MaterialKind,
-    RgbBatch, albedo, direction,
+    PairTerms, RgbBatch, albedo, direction,
 };
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::DVec3;
@@ -194,6 +194,19 @@ fn patch_sum_pair<const CH: usize>(
                     }
                 }
                 total += f_sum[0] + grad_sum.d[4][0];
+            }
+            total
+        })
+    });
+    // Every pair's terms, in runs (what a fit to measured samples asks).
+    group.bench_function(format!("{name}/each"), |b| {
+        let mut terms = PairTerms::new();
+        b.iter(|| {
+            let mut total = 0.0;
+            for start in (0..geometry.len()).step_by(run) {
+                let range = start..(start + run).min(geometry.len());
+                black_box(&bsdf).eval_geometry_each_with_gradient::<CH>(&batch, range, &mut terms);
+                total += terms.value(0, 0) + terms.derivative(terms.len() - 1, 4, 0);
             }
             total
         })
