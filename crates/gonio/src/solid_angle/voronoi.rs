@@ -222,7 +222,8 @@ fn ghost_ring() -> impl Iterator<Item = [f64; 2]> {
 /// in a fixed number of parts, added in a fixed order, so the result does
 /// not depend on the thread count or scheduling.
 fn cell_areas(vertices: &[[f64; 2]], tri: &Triangulation) -> Option<Vec<f64>> {
-    const PARTS: usize = 4;
+    // Two parts: both cores busy, and each part costs a zeroed array per vertex.
+    const PARTS: usize = 2;
     let computed: Vec<[f64; 2]>;
     let circumcentres = if tri.circumcentres.len() == tri.triangles.len() / 3 {
         &tri.circumcentres
