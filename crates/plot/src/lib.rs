@@ -158,46 +158,70 @@ impl Job<'_> {
     }
 }
 
-/// Renders every job and writes its files; returns the paths in `jobs` order.
-/// The files are written by a thread of their own, so that rendering never
+/// Threads that write files: most of a write is waiting for the disk to
+/// sync, so several run at once and the syncs overlap.
+const WRITERS: usize = 4;
+
+/// Renders every job and writes its files, then `last` (the report) once
+/// every job rendered; returns the paths in `jobs` order, then `last`'s.
+/// The files are written by threads of their own, so that rendering never
 /// waits for the disk (each write syncs).
-fn render_and_write(jobs: &[Job], dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
+fn render_and_write(
+    jobs: &[Job],
+    dir: &Path,
+    last: (PathBuf, Vec<u8>),
+) -> Result<Vec<PathBuf>, PlotError> {
+    let (send, receive) = std::sync::mpsc::channel::<(PathBuf, Vec<u8>)>();
+    let receive = std::sync::Mutex::new(receive);
+    // After the first failure nothing more is written.
+    let failed = std::sync::atomic::AtomicBool::new(false);
     std::thread::scope(|scope| {
-        let (send, receive) = std::sync::mpsc::channel::<(PathBuf, Vec<u8>)>();
-        let writer = scope.spawn(move || {
-            // The first failure is kept; nothing after it is written.
-            let mut outcome = Ok(());
-            for (path, bytes) in receive {
-                if outcome.is_ok() {
-                    outcome = write_atomic(&path, &bytes);
-                }
-            }
-            outcome
-        });
+        let writers: Vec<_> = (0..WRITERS)
+            .map(|_| {
+                scope.spawn(|| {
+                    let mut outcome = Ok(());
+                    loop {
+                        let next = receive.lock().unwrap_or_else(|e| e.into_inner()).recv();
+                        let Ok((path, bytes)) = next else {
+                            return outcome;
+                        };
+                        if !failed.load(std::sync::atomic::Ordering::Relaxed) {
+                            outcome = write_atomic(&path, &bytes);
+                            if outcome.is_err() {
+                                failed.store(true, std::sync::atomic::Ordering::Relaxed);
+                            }
+                        }
+                    }
+                })
+            })
+            .collect();
         let render = |job: &Job| -> Result<Vec<PathBuf>, PlotError> {
             let files = job.render(dir)?;
             let paths = files.iter().map(|(p, _)| p.clone()).collect();
             for file in files {
-                // The writer only stops early on a failure, reported below.
+                // The writers only stop early on a failure, reported below.
                 let _ = send.send(file);
             }
             Ok(paths)
         };
-        let mut rendered: Vec<(usize, Result<Vec<PathBuf>, PlotError>)> = jobs
-            .par_iter()
-            .enumerate()
-            .map(|(k, j)| (k, render(j)))
-            .collect();
-        drop(send);
-        let written = writer
-            .join()
-            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-        rendered.sort_by_key(|(k, _)| *k);
-        let mut files = Vec::new();
-        for (_, r) in rendered {
-            files.extend(r?);
+        let rendered: Result<Vec<Vec<PathBuf>>, PlotError> = jobs.par_iter().map(render).collect();
+        let last_path = last.0.clone();
+        if rendered.is_ok() {
+            let _ = send.send(last);
         }
+        drop(send);
+        let mut written = Ok(());
+        for writer in writers {
+            let outcome = writer
+                .join()
+                .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+            if written.is_ok() {
+                written = outcome;
+            }
+        }
+        let mut files: Vec<PathBuf> = rendered?.into_iter().flatten().collect();
         written?;
+        files.push(last_path);
         Ok(files)
     })
 }
@@ -371,9 +395,6 @@ fn plot(
         jobs.push(Job::Cuts(cuts));
     }
 
-    let mut files = render_and_write(&jobs, &plots)?;
-    remove_stale(&plots, &files);
-
     let entries = result
         .incidences
         .iter()
@@ -412,9 +433,10 @@ fn plot(
         warnings: &warnings,
         ratio,
     });
+    // The report is written with the plots' files, once they all rendered.
     let report_path = dir.join("report.html");
-    write_atomic(&report_path, html.as_bytes())?;
-    files.push(report_path.clone());
+    let files = render_and_write(&jobs, &plots, (report_path.clone(), html.into_bytes()))?;
+    remove_stale(&plots, &files);
     Ok(Written {
         files,
         report: report_path,
