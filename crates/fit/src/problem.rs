@@ -470,25 +470,25 @@ impl Kernel<'_> {
     ) {
         let channels = self.channels;
         let n = terms.len();
-        columns.reset(n * channels, W);
+        let rows = n * channels;
+        columns.reset(rows, W);
         dr_dm.clear();
+        dr_dm.resize(rows, 0.0);
+        let samples = &block.samples[first..first + n];
+        let factors = &block.factors[first * channels..][..rows];
+        let logs =
+            (!block.log_values.is_empty()).then(|| &block.log_values[first * channels..][..rows]);
         let residuals = columns.column_mut(W - 1);
-        for j in 0..n {
-            let i = first + j;
-            let s = &block.samples[i];
-            for ch in 0..channels {
-                let row = i * channels + ch;
-                let (res, d, rel2) = self.residual(
-                    terms.value(j, ch),
-                    s.value[ch],
-                    block.factors[row],
-                    block.log_value(row),
-                );
+        for ch in 0..channels {
+            for (j, (s, &f)) in samples.iter().zip(terms.value_column(ch)).enumerate() {
+                let r = j * channels + ch;
+                let log_y = logs.map_or(f64::NAN, |l| l[r]);
+                let (res, d, rel2) = self.residual(f, s.value[ch], factors[r], log_y);
                 if REPORT {
                     sums.sum_rel += rel2;
                 }
-                residuals[j * channels + ch] = res;
-                dr_dm.push(d);
+                residuals[r] = res;
+                dr_dm[r] = d;
             }
         }
         for (c, &(target, dp_du)) in self.columns[..W - 1].iter().enumerate() {
@@ -502,14 +502,21 @@ impl Kernel<'_> {
                     Target::Gray => (terms.derivative_column(ch, ch), self.scale * dp_du),
                     Target::Scale => (Some(terms.value_column(ch)), dp_du),
                 };
-                match source {
-                    Some(source) => {
+                match (source, channels) {
+                    // One channel: plain slices, which the compiler
+                    // vectorises.
+                    (Some(source), 1) => {
+                        for ((o, &g), &d) in out.iter_mut().zip(dr_dm.iter()).zip(source) {
+                            *o = g * d * factor;
+                        }
+                    }
+                    (Some(source), _) => {
                         for (j, &d) in source.iter().enumerate() {
                             let r = j * channels + ch;
                             out[r] = dr_dm[r] * d * factor;
                         }
                     }
-                    None => {
+                    (None, _) => {
                         for j in 0..n {
                             out[j * channels + ch] = 0.0;
                         }
