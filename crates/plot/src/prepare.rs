@@ -320,7 +320,8 @@ fn build(
         .with_min_len(BLOCK)
         .map(|s| s.direction())
         .collect();
-    let samples_with_model = || -> Vec<Vec<(PlotSample, Option<[f64; 3]>)>> {
+    // Each block: its samples, and the errors of its fitted ones in order.
+    let samples_with_model = || -> Vec<(Vec<PlotSample>, Vec<[f64; 3]>)> {
         m.samples
             .par_chunks(BLOCK)
             .zip(removed_by.par_chunks(BLOCK))
@@ -357,7 +358,8 @@ fn build(
                         );
                     }
                 }
-                block
+                let mut rels = Vec::new();
+                let samples = block
                     .iter()
                     .zip(removed)
                     .zip(dirs)
@@ -386,9 +388,13 @@ fn build(
                             removed_by: *removed,
                             log_ratio: log_ratio(data, model, floor),
                         };
-                        (sample, removed.is_none().then_some(rel))
+                        if removed.is_none() {
+                            rels.push(rel);
+                        }
+                        sample
                     })
-                    .collect()
+                    .collect();
+                (samples, rels)
             })
             .collect()
     };
@@ -414,21 +420,20 @@ fn build(
     let (blocks, (front, back)) = rayon::join(samples_with_model, || {
         rayon::join(|| grid_of(Hemisphere::Front), || grid_of(Hemisphere::Back))
     });
-    let rows = blocks.into_iter().flatten();
+    // Whole blocks copied into one vector; the errors summed in sample order.
+    let mut samples: Vec<PlotSample> = Vec::with_capacity(m.samples.len());
     let mut sum_rel = 0.0;
     let mut n_used = 0usize;
-    let samples: Vec<PlotSample> = rows
-        .into_iter()
-        .map(|(sample, rel)| {
-            if let Some(rel) = rel {
-                for r in rel.iter().take(channels) {
-                    sum_rel += r;
-                }
-                n_used += 1;
+    for (block, rels) in &blocks {
+        samples.extend_from_slice(block);
+        for rel in rels {
+            for r in rel.iter().take(channels) {
+                sum_rel += r;
             }
-            sample
-        })
-        .collect();
+        }
+        n_used += rels.len();
+    }
+    drop(blocks);
     if n_used != report.n_points {
         warnings.push(format!(
             "{}: {} samples are marked as fitted here but the fit used {}; \
