@@ -4,10 +4,15 @@
 //! The points to triangulate all lie strictly inside a convex polygon whose
 //! corners are given first (the ghost ring of `voronoi`). That polygon is
 //! triangulated as a fan, then every point is inserted in Hilbert-curve
-//! order: a visibility walk from the previous point's triangle finds the
-//! triangle that holds the new point, the triangle is split in three and
-//! Lawson flips restore the Delaunay property. Because every point is inside
-//! the polygon, the convex hull never changes and no "outside" case exists.
+//! order: a visibility walk from a triangle of the point's neighbour on the
+//! curve (or of the previous point) finds the triangle that holds the new
+//! point, the triangle is split in three and Lawson flips restore the
+//! Delaunay property. Because every point is inside the polygon, the convex
+//! hull never changes and no "outside" case exists.
+//!
+//! With two threads the points left and right of their median x are
+//! triangulated in parallel and the seam between them is triangulated
+//! again, with a checked certificate ([`triangulate_in_polygon_split`]).
 //!
 //! Why not `delaunator`: the real pgII scans are long paths of near-collinear
 //! points 0.04° apart. delaunator's sweep adds them in order of distance from

@@ -28,9 +28,10 @@
 //! The triangulation is our own incremental Delaunay in a biased randomised
 //! Hilbert order with exact predicates (module `delaunay`), about three
 //! times faster in CPU time than `delaunator` on the real scans' long
-//! near-collinear paths; the cells are then computed in parallel. The
-//! Voronoi diagram does not
-//! depend on the triangulation method, so both give the same cells up to
+//! near-collinear paths, and run on two threads (the halves either side of
+//! the median x, then their seam); the cells are then summed edge by edge
+//! in parallel. The Voronoi diagram does not depend on the triangulation
+//! method, so both give the same cells up to
 //! rounding; [`reference_disk_voronoi_areas`] keeps the former
 //! delaunator-based computation as the reference the tests compare with,
 //! and as the fallback for points the fast path does not accept (outside
