@@ -258,27 +258,26 @@ impl Bsdf {
         std::array::from_fn(|ch| if ch < CH { sums[0][ch] } else { 0.0 })
     }
 
-    /// Picks the kernel for this material's switches.
+    /// The sums, for this material's switches.
     fn sum_dispatch<const GRAD: bool, const CH: usize>(&self, g: Columns) -> [[f64; 3]; ROWS] {
         assert!(CH <= 3, "CH = {CH}: at most 3 channels");
+        self.by_switches(Sums::<GRAD, CH> { g })
+    }
+
+    /// Runs `kernel` compiled for this material's switches: its type's
+    /// anisotropy and transmission, the formula set, and rtrace's Fresnel
+    /// switch.
+    fn by_switches<K: SwitchedKernel>(&self, kernel: K) -> K::Output {
         let k = self.batch_constants();
         let variant = self.options().variant;
         let fresnel = self.has_fresnel();
         macro_rules! run {
             ($a:literal, $t:literal) => {
                 match (variant, fresnel) {
-                    (Variant::Radiance, true) => {
-                        sum_kernel::<GRAD, CH, $a, $t, RADIANCE, true>(&k, g)
-                    }
-                    (Variant::Radiance, false) => {
-                        sum_kernel::<GRAD, CH, $a, $t, RADIANCE, false>(&k, g)
-                    }
-                    (Variant::Manual2004, _) => {
-                        sum_kernel::<GRAD, CH, $a, $t, MANUAL2004, false>(&k, g)
-                    }
-                    (Variant::Ward1992, _) => {
-                        sum_kernel::<GRAD, CH, $a, $t, WARD1992, false>(&k, g)
-                    }
+                    (Variant::Radiance, true) => kernel.run::<$a, $t, RADIANCE, true>(&k),
+                    (Variant::Radiance, false) => kernel.run::<$a, $t, RADIANCE, false>(&k),
+                    (Variant::Manual2004, _) => kernel.run::<$a, $t, MANUAL2004, false>(&k),
+                    (Variant::Ward1992, _) => kernel.run::<$a, $t, WARD1992, false>(&k),
                 }
             };
         }
@@ -291,19 +290,30 @@ impl Bsdf {
     }
 }
 
-/// The sums, compiled for the best SIMD level of this CPU.
-fn sum_kernel<
-    const GRAD: bool,
-    const CH: usize,
-    const ANISO: bool,
-    const TRANS: bool,
-    const V: u8,
-    const FRESNEL: bool,
->(
-    k: &Constants,
-    g: Columns,
-) -> [[f64; 3]; ROWS] {
-    pulp::Arch::new().dispatch(SumOp::<GRAD, CH, ANISO, TRANS, V, FRESNEL> { k, g })
+/// A kernel compiled once per material switch: anisotropic, transmitting,
+/// the formula set `V` and rtrace's Fresnel switch.
+trait SwitchedKernel {
+    type Output;
+    fn run<const ANISO: bool, const TRANS: bool, const V: u8, const FRESNEL: bool>(
+        self,
+        k: &Constants,
+    ) -> Self::Output;
+}
+
+/// The sums over pairs, compiled for the best SIMD level of this CPU.
+struct Sums<'a, const GRAD: bool, const CH: usize> {
+    g: Columns<'a>,
+}
+
+impl<const GRAD: bool, const CH: usize> SwitchedKernel for Sums<'_, GRAD, CH> {
+    type Output = [[f64; 3]; ROWS];
+
+    fn run<const ANISO: bool, const TRANS: bool, const V: u8, const FRESNEL: bool>(
+        self,
+        k: &Constants,
+    ) -> Self::Output {
+        pulp::Arch::new().dispatch(SumOp::<GRAD, CH, ANISO, TRANS, V, FRESNEL> { k, g: self.g })
+    }
 }
 
 /// Every pair's `f` and gradient, from [`Bsdf::eval_geometry_each`] and
@@ -459,61 +469,36 @@ impl Bsdf {
         self.each_dispatch::<true, CH>(g.columns(range), out);
     }
 
-    /// Picks the per-pair kernel for this material's switches.
+    /// The per-pair terms, for this material's switches.
     fn each_dispatch<const GRAD: bool, const CH: usize>(&self, g: Columns, out: &mut PairTerms) {
         assert!(CH <= 3, "CH = {CH}: at most 3 channels");
-        let anisotropic = self.kind().is_anisotropic();
-        let transmitting = self.kind().is_transmitting();
-        out.reset(
-            g.light_cosine.len(),
-            term_rows(GRAD, anisotropic, transmitting),
-            CH,
+        let rows = term_rows(
+            GRAD,
+            self.kind().is_anisotropic(),
+            self.kind().is_transmitting(),
         );
-        let k = self.batch_constants();
-        let variant = self.options().variant;
-        let fresnel = self.has_fresnel();
-        let data = out.columns_mut();
-        macro_rules! run {
-            ($a:literal, $t:literal) => {
-                match (variant, fresnel) {
-                    (Variant::Radiance, true) => {
-                        each_kernel::<GRAD, CH, $a, $t, RADIANCE, true>(&k, g, data)
-                    }
-                    (Variant::Radiance, false) => {
-                        each_kernel::<GRAD, CH, $a, $t, RADIANCE, false>(&k, g, data)
-                    }
-                    (Variant::Manual2004, _) => {
-                        each_kernel::<GRAD, CH, $a, $t, MANUAL2004, false>(&k, g, data)
-                    }
-                    (Variant::Ward1992, _) => {
-                        each_kernel::<GRAD, CH, $a, $t, WARD1992, false>(&k, g, data)
-                    }
-                }
-            };
-        }
-        match (anisotropic, transmitting) {
-            (false, false) => run!(false, false),
-            (false, true) => run!(false, true),
-            (true, false) => run!(true, false),
-            (true, true) => run!(true, true),
-        }
+        out.reset(g.light_cosine.len(), rows, CH);
+        let out = out.columns_mut();
+        self.by_switches(Each::<GRAD, CH> { g, out });
     }
 }
 
 /// The per-pair terms, compiled for the best SIMD level of this CPU.
-fn each_kernel<
-    const GRAD: bool,
-    const CH: usize,
-    const ANISO: bool,
-    const TRANS: bool,
-    const V: u8,
-    const FRESNEL: bool,
->(
-    k: &Constants,
-    g: Columns,
-    out: &mut [f64],
-) {
-    pulp::Arch::new().dispatch(EachOp::<GRAD, CH, ANISO, TRANS, V, FRESNEL> { k, g, out });
+struct Each<'a, const GRAD: bool, const CH: usize> {
+    g: Columns<'a>,
+    out: &'a mut [f64],
+}
+
+impl<const GRAD: bool, const CH: usize> SwitchedKernel for Each<'_, GRAD, CH> {
+    type Output = ();
+
+    fn run<const ANISO: bool, const TRANS: bool, const V: u8, const FRESNEL: bool>(
+        self,
+        k: &Constants,
+    ) {
+        let (g, out) = (self.g, self.out);
+        pulp::Arch::new().dispatch(EachOp::<GRAD, CH, ANISO, TRANS, V, FRESNEL> { k, g, out });
+    }
 }
 
 /// The per-pair kernel as a `pulp` operation (see [`SumOp`]): the same
