@@ -9,13 +9,13 @@
 //!   The target of issue 18 is 40 ms.
 //! * `plots/write_plots`: the same as `brtf plot` does it, with the file
 //!   read again and rebuilt with the fit's recipe.
-//! * `plots/load`: only the rebuild of the data ([`brtf_plot::prepare::load`];
-//!   the nearest-sample grids are made later, when first drawn).
+//! * `plots/load`: only the rebuild of the data ([`brtf_plot::prepare::load`],
+//!   with the nearest-sample grids, made at the same time as the model).
 //! * `plots/coverage`: the nearest-sample grid of the front disk
 //!   ([`brtf_plot::disk::Coverage`]), which the map and the reflectance
 //!   chart share.
 //! * `plots/map_png`, `plots/map_svg`: the residual map alone, on data
-//!   already loaded (its nearest-sample grid made afresh each time).
+//!   loaded afresh each time (outside the timing, grids included).
 
 use brtf_fit::{FitConfig, FitSetOptions, NoProgress, Recipe};
 use brtf_gonio::Hemisphere;
