@@ -51,6 +51,7 @@ assert peer.stdout.readline().strip() == "ready"
 
 
 cpu = {"lean": [], "full": []}
+PAUSE = 0.5  # seconds
 
 
 def run(key, command):
@@ -70,6 +71,9 @@ for _ in range(rounds):
     peer.stdin.write("fit\n")
     peer.stdin.flush()
     times["scipy"].append(float(peer.stdout.readline().split()[0]) / 1e3)
+    # BLAS worker threads keep spinning for a while after the scipy fit;
+    # without a pause they take a core from the next brtf run.
+    time.sleep(PAUSE)
 peer.stdin.close()
 peer.wait()
 
