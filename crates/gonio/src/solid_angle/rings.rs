@@ -45,6 +45,54 @@ struct Ring {
 /// The cell solid angles (sr) of `directions` (θ, φ in degrees, valid and
 /// all in `hemisphere`) when they form a ring layout, else `None`.
 pub(crate) fn ring_areas(directions: &[(f64, f64)], hemisphere: Hemisphere) -> Option<Vec<f64>> {
+    if has_wide_run(directions, hemisphere) {
+        return None;
+    }
+    sorted_ring_areas(directions, hemisphere)
+}
+
+/// Width of the θ' bins of [`has_wide_run`], degrees: two values in
+/// neighbouring bins are less than `2 · RUN_BIN_DEG = RING_JITTER_DEG`
+/// apart, so they fall in one ring.
+const RUN_BIN_DEG: f64 = 0.5 * RING_JITTER_DEG;
+/// Occupied neighbouring bins that prove a ring wider than
+/// `MAX_RING_SPREAD_DEG`: their values chain into one ring spanning more
+/// than `(RUN_BINS − 2) · RUN_BIN_DEG` = 0.025° (one bin of margin for
+/// the rounding of the bin index).
+const RUN_BINS: usize = 7;
+
+/// True when the directions' θ' values (from the hemisphere's normal)
+/// occupy [`RUN_BINS`] neighbouring bins of [`RUN_BIN_DEG`]: then they
+/// chain into a ring wider than [`MAX_RING_SPREAD_DEG`], and
+/// [`sorted_ring_areas`] would find no ring layout. One pass, no sort: the
+/// scattered layouts of real scans are refused at a fraction of the
+/// sort's cost. `false` says nothing.
+fn has_wide_run(directions: &[(f64, f64)], hemisphere: Hemisphere) -> bool {
+    let bins = (90.0 / RUN_BIN_DEG) as usize + 1;
+    let mut occupied = vec![false; bins];
+    for &(theta, _) in directions {
+        let from_normal = match hemisphere {
+            Hemisphere::Front => theta,
+            Hemisphere::Back => 180.0 - theta,
+        };
+        // Values outside 0..=90 (none for valid directions) are left out:
+        // fewer occupied bins only make a proof less likely.
+        if (0.0..=90.0).contains(&from_normal) {
+            occupied[((from_normal / RUN_BIN_DEG) as usize).min(bins - 1)] = true;
+        }
+    }
+    let mut run = 0;
+    for &o in &occupied {
+        run = if o { run + 1 } else { 0 };
+        if run >= RUN_BINS {
+            return true;
+        }
+    }
+    false
+}
+
+/// [`ring_areas`] by sorting all directions by θ'.
+fn sorted_ring_areas(directions: &[(f64, f64)], hemisphere: Hemisphere) -> Option<Vec<f64>> {
     let n = directions.len();
     if u32::try_from(n).is_err() {
         return None;
@@ -204,6 +252,71 @@ mod tests {
         assert_eq!(areas[0], areas[4]);
         assert!((areas[0] * 2.0 - areas[1]).abs() < 1e-15);
         assert!((areas.iter().sum::<f64>() - TAU).abs() < 1e-12);
+    }
+
+    type Directions = Vec<(f64, f64)>;
+
+    /// The run test refuses only what the sort refuses: on both real
+    /// scans (both hemispheres), ring grids with jitter, in-plane scans and
+    /// scattered sets, `ring_areas` equals `sorted_ring_areas`, and the
+    /// real scans are refused by the run test itself.
+    #[test]
+    fn the_run_test_agrees_with_the_sort() {
+        let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../../shared/data/rgl-epfl-pgII-raw");
+        let mut sets: Vec<(String, Directions, Hemisphere)> = Vec::new();
+        for file in ["golden_paper.txt", "layer_020_030.txt"] {
+            let m = crate::read_path(&data.join(file)).unwrap();
+            for hemisphere in [Hemisphere::Front, Hemisphere::Back] {
+                let directions: Vec<(f64, f64)> = m
+                    .samples
+                    .iter()
+                    .filter(|s| s.hemisphere() == hemisphere)
+                    .map(|s| (s.theta_deg, s.phi_deg))
+                    .collect();
+                if directions.len() > 1000 {
+                    assert!(has_wide_run(&directions, hemisphere), "{file}");
+                }
+                sets.push((format!("{file} {hemisphere:?}"), directions, hemisphere));
+            }
+        }
+        let mut state = 0x9E37_79B9_7F4A_7C15u64;
+        let mut uniform = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for jitter in [0.0, 0.0001, 0.004, 0.02] {
+            let mut grid = Vec::new();
+            for t in 0..=170 {
+                for p in 0..60 {
+                    let theta = (0.5 * t as f64 + jitter * (uniform() - 0.5)).clamp(0.0, 90.0);
+                    grid.push((theta, 6.0 * p as f64));
+                }
+            }
+            sets.push((format!("grid, jitter {jitter}"), grid, Hemisphere::Front));
+        }
+        let back: Vec<(f64, f64)> = (0..=60)
+            .flat_map(|t| (0..24).map(move |p| (180.0 - 1.5 * t as f64, 15.0 * p as f64)))
+            .collect();
+        sets.push(("back grid".into(), back, Hemisphere::Back));
+        let chain: Vec<(f64, f64)> = (0..5000).map(|i| (i as f64 * 0.004, 0.0)).collect();
+        sets.push(("chain 0.004°".into(), chain, Hemisphere::Front));
+        let random: Vec<(f64, f64)> = (0..20_000)
+            .map(|_| (90.0 * uniform(), 360.0 * uniform()))
+            .collect();
+        sets.push(("random".into(), random, Hemisphere::Front));
+        for (name, directions, hemisphere) in &sets {
+            assert_eq!(
+                ring_areas(directions, *hemisphere),
+                sorted_ring_areas(directions, *hemisphere),
+                "{name}"
+            );
+        }
+        // Not vacuous: some sets are rings, some are refused by the run test.
+        assert!(sets.iter().any(|(_, d, h)| ring_areas(d, *h).is_some()));
+        assert!(sets.iter().filter(|(_, d, h)| has_wide_run(d, *h)).count() >= 4);
     }
 
     #[test]
