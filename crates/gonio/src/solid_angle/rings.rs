@@ -280,13 +280,8 @@ mod tests {
                 sets.push((format!("{file} {hemisphere:?}"), directions, hemisphere));
             }
         }
-        let mut state = 0x9E37_79B9_7F4A_7C15u64;
-        let mut uniform = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = brtf_model::Rng::new(18, 0);
+        let mut uniform = move || rng.uniform();
         for jitter in [0.0, 0.0001, 0.004, 0.02] {
             let mut grid = Vec::new();
             for t in 0..=170 {
