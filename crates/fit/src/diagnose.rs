@@ -105,36 +105,31 @@ pub(crate) struct Measured {
     pub back: Option<(f64, f64)>,
 }
 
-/// Σ y |cos θ| ΔΩ and Σ scale·f |cos θ| ΔΩ over the fitted samples.
+/// Σ y |cos θ| ΔΩ and Σ scale·f |cos θ| ΔΩ over the fitted samples
+/// (which `data`, the fitter's view of `prepared`, holds).
 pub(crate) fn measured_integrals(
     prepared: &PreparedMeasurement,
+    data: &IncidenceData,
     bsdf: &Bsdf,
     scale: f64,
 ) -> Measured {
-    measured_sums(prepared, &fitted_model(prepared, bsdf), scale)
+    measured_sums(prepared, &fitted_model(prepared, data, bsdf), scale)
 }
 
 /// The model's value (in luminance) at every fitted sample of `prepared`,
-/// in the order of [`PreparedMeasurement::fitted`]. Evaluated in parallel;
-/// the sums over them stay in sample order.
-fn fitted_model(prepared: &PreparedMeasurement, bsdf: &Bsdf) -> Vec<f64> {
+/// in the order of [`PreparedMeasurement::fitted`], at the directions of
+/// the fitter's view of them (`data`), or averaged over their patch pairs.
+/// Evaluated in parallel; the sums over them stay in sample order.
+fn fitted_model(prepared: &PreparedMeasurement, data: &IncidenceData, bsdf: &Bsdf) -> Vec<f64> {
     let channels = prepared.channels();
-    let indices: Vec<usize> = prepared.fitted().map(|(i, _)| i).collect();
-    indices
-        .par_iter()
-        .with_min_len(4096)
-        .map(|&i| luminance(prepared.model_value(bsdf, i), channels))
-        .collect()
-}
-
-/// [`fitted_model`] from the fitter's own view of the same samples
-/// (`data`, made from `prepared`): the same directions, not computed
-/// again. Patch-averaged data go through [`fitted_model`].
-fn fitted_model_at(prepared: &PreparedMeasurement, data: &IncidenceData, bsdf: &Bsdf) -> Vec<f64> {
     if prepared.patch_pairs.is_some() {
-        return fitted_model(prepared, bsdf);
+        let indices: Vec<usize> = prepared.fitted().map(|(i, _)| i).collect();
+        return indices
+            .par_iter()
+            .with_min_len(4096)
+            .map(|&i| luminance(prepared.model_value(bsdf, i), channels))
+            .collect();
     }
-    let channels = prepared.channels();
     let light = prepared.measurement.incident_direction();
     data.samples
         .par_iter()
@@ -186,7 +181,7 @@ pub(crate) fn diagnose(
     let scale = report.scale;
     let ((rho_model, tau_model), model) = rayon::join(
         || model_albedo(prepared, &bsdf),
-        || fitted_model_at(prepared, data, &bsdf),
+        || fitted_model(prepared, data, &bsdf),
     );
     let measured = measured_sums(prepared, &model, scale);
     // Data's reflectance: measured part ÷ scale, plus the model's rest.

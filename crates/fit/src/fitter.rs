@@ -67,7 +67,7 @@ pub(crate) enum SharedGeometry {
     Samples(GeometryBatch),
     /// Nothing kept (pairs beyond the memory budget): the kernel computes
     /// the geometry on every pass.
-    None,
+    Recomputed,
 }
 
 /// The geometry of each of `data`'s incidences (see [`SharedGeometry`]).
@@ -88,7 +88,7 @@ pub(crate) fn shared_geometry(
         .par_iter()
         .map(|d| match d.patch_pairs.as_deref() {
             Some(pairs) if keep_pairs => SharedGeometry::Pairs(PairGeometry::new(pairs, &bsdf)),
-            Some(_) => SharedGeometry::None,
+            Some(_) => SharedGeometry::Recomputed,
             None => SharedGeometry::Samples(sample_geometry(&bsdf, d.light(), &d.samples)),
         })
         .collect())
@@ -146,7 +146,7 @@ fn fit_many(
             Some(SharedGeometry::Samples(g)) => {
                 scan.block.sample_geometry = Some(Cow::Borrowed(g));
             }
-            Some(SharedGeometry::None) | None => {}
+            Some(SharedGeometry::Recomputed) | None => {}
         }
         blocks.push(scan.block);
         stats.push(scan.stats);

@@ -220,7 +220,13 @@ pub fn fit_set_with_data(
                 used: reports[nearest].theta_in,
             });
         }
-        let k = instrument_scale(&config, &inputs[nearest].prepared, &reports[nearest], rho)?;
+        let k = instrument_scale(
+            &config,
+            &inputs[nearest].prepared,
+            &data[nearest],
+            &reports[nearest],
+            rho,
+        )?;
         for input in &mut inputs {
             input.prepared.rescale_known_reflectance(k, rho, theta);
             input.file.conversion = input.prepared.conversion.clone();
@@ -387,6 +393,7 @@ pub fn prepare_input(
 fn instrument_scale(
     config: &FitConfig,
     prepared: &PreparedMeasurement,
+    data: &IncidenceData,
     report: &FitReport,
     rho: f64,
 ) -> Result<f64, FitSetError> {
@@ -403,7 +410,7 @@ fn instrument_scale(
     })?;
     let bsdf = brtf_model::Bsdf::new(&material, &config.options);
     let (rho_model, _) = diagnose::model_albedo(prepared, &bsdf);
-    let measured = diagnose::measured_integrals(prepared, &bsdf, report.scale);
+    let measured = diagnose::measured_integrals(prepared, data, &bsdf, report.scale);
     let (data, model) = measured.front.unwrap_or((0.0, 0.0));
     let k = (data + report.scale * rho_model - model) / rho;
     if k.is_finite() && k > 0.0 {
