@@ -45,6 +45,13 @@ enum Command {
     Plot(cmd::plot::PlotArgs),
 }
 
+// glibc's malloc hands big freed blocks back to the kernel and faults them
+// in again page by page on the next allocation: a golden_paper fit took
+// 18.6k page faults, about a fifth of its CPU time. mimalloc keeps and
+// reuses them (about 400 faults). See docs/benchmarks.md.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 /// Exit codes (docs/outputs.md): 0 on success and when the reader of
 /// standard output has gone (as ripgrep), 1 on every error, the command
 /// line's included; `--help` and `--version` exit 0.
