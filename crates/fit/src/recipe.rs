@@ -20,8 +20,8 @@ use brtf_gonio::{Gate, GateContext, Measurement, Quantity, SolidAngleSource};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-/// Samples per parallel piece of the gates.
-const GATE_PIECE: usize = 8192;
+/// Samples per parallel piece of the gates and of the fitter's samples.
+const SAMPLE_PIECE: usize = 8192;
 
 /// How the scale of raw-signal files is fixed.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -402,36 +402,31 @@ impl Recipe {
     /// Applies the recipe to `measurement`, read from `source`.
     pub fn prepare(
         &self,
-        mut measurement: Measurement,
+        measurement: Measurement,
         source: &str,
     ) -> Result<PreparedMeasurement, RecipeError> {
-        // The weights describe the full layout, so they come first.
-        let solid_angles = measurement.fill_solid_angles();
-        let weighting = match (self.weights, solid_angles) {
+        // The weights describe the full layout, so they are computed from
+        // every sample; the conversion and the gates do not read them, so
+        // they run beside (the solid angles are the longest step).
+        let (solid_angles, converted) = rayon::join(
+            || brtf_gonio::solid_angles(&measurement),
+            || self.convert_and_gate(&measurement, source),
+        );
+        let (mut measurement, conversion, removed_by) = converted?;
+        // The conversions keep the samples and their order.
+        debug_assert_eq!(measurement.samples.len(), solid_angles.per_sample_sr.len());
+        for (sample, w) in measurement
+            .samples
+            .iter_mut()
+            .zip(&solid_angles.per_sample_sr)
+        {
+            sample.solid_angle_sr = Some(*w);
+        }
+        let weighting = match (self.weights, solid_angles.source) {
             (WeightRule::Uniform, _) => Weighting::Uniform,
             (WeightRule::SolidAngle, SolidAngleSource::File) => Weighting::FileSolidAngles,
             (WeightRule::SolidAngle, SolidAngleSource::Computed) => Weighting::ComputedSolidAngles,
         };
-        if self.colour == ColourConversion::XyzToRadianceRgb
-            && measurement.channels == brtf_gonio::Channels::Xyz
-        {
-            for sample in &mut measurement.samples {
-                sample.values = brtf_model::colour::xyz_to_rgb(sample.values);
-            }
-        }
-        let (measurement, conversion) = self.convert(&measurement, source)?;
-        // Each sample is removed by the first gate it fails, if any.
-        let context = GateContext::of(&measurement);
-        let removed_by: Vec<Option<usize>> = measurement
-            .samples
-            .par_iter()
-            .with_min_len(GATE_PIECE)
-            .map(|sample| {
-                self.selections
-                    .iter()
-                    .position(|gate| !gate.keeps(sample, &context))
-            })
-            .collect();
         let mut counts = vec![0; self.selections.len()];
         for &g in removed_by.iter().flatten() {
             counts[g] += 1;
@@ -454,6 +449,39 @@ impl Recipe {
             weighting,
             patch_pairs: None,
         })
+    }
+
+    /// The colour conversion, the fitted quantity (step 3) and the gates:
+    /// the converted measurement and, per sample, the first gate it fails.
+    fn convert_and_gate(
+        &self,
+        measurement: &Measurement,
+        source: &str,
+    ) -> Result<(Measurement, Conversion, Vec<Option<usize>>), RecipeError> {
+        let (measurement, conversion) = if self.colour == ColourConversion::XyzToRadianceRgb
+            && measurement.channels == brtf_gonio::Channels::Xyz
+        {
+            let mut rgb = measurement.clone();
+            for sample in &mut rgb.samples {
+                sample.values = brtf_model::colour::xyz_to_rgb(sample.values);
+            }
+            self.convert(&rgb, source)?
+        } else {
+            self.convert(measurement, source)?
+        };
+        // Each sample is removed by the first gate it fails, if any.
+        let context = GateContext::of(&measurement);
+        let removed_by = measurement
+            .samples
+            .par_iter()
+            .with_min_len(SAMPLE_PIECE)
+            .map(|sample| {
+                self.selections
+                    .iter()
+                    .position(|gate| !gate.keeps(sample, &context))
+            })
+            .collect();
+        Ok((measurement, conversion, removed_by))
     }
 
     /// Step 3: the fitted quantity.
@@ -585,9 +613,15 @@ impl PreparedMeasurement {
             theta_in: self.measurement.incidence.theta_deg,
             phi_in: self.measurement.incidence.phi_deg,
             channels: self.channels(),
+            // In parallel pieces: each direction costs two sin_cos.
             samples: self
-                .fitted()
-                .map(|(_, s)| FitSample {
+                .measurement
+                .samples
+                .par_iter()
+                .zip(&self.removed_by)
+                .with_min_len(SAMPLE_PIECE)
+                .filter(|(_, removed)| removed.is_none())
+                .map(|(s, _)| FitSample {
                     view: s.direction(),
                     value: s.values,
                     weight: if uniform {
