@@ -39,10 +39,35 @@ pub(crate) struct Triangulation {
     pub triangles: Vec<u32>,
     /// The twin of each halfedge, or [`NONE`].
     pub halfedges: Vec<u32>,
-    /// Empty, or the circumcentre of each triangle slot as
-    /// [`circumcentre`] gives it from the stored vertices (anything for
-    /// unused slots).
-    pub circumcentres: Vec<[f64; 2]>,
+}
+
+/// Receives each inner edge of the final triangulation exactly once (not
+/// the polygon's sides), into one of the accumulators, as the halfedge
+/// `from` → `to` with the circumcentres of the triangle on its left (the
+/// one holding that halfedge) and on its right: the edge's dual Voronoi
+/// edge. A circumcentre is what [`circumcentre`] gives from the triangle's
+/// vertices in their stored rotation.
+pub(crate) trait EdgeVisitor: Sync {
+    /// What the edges are accumulated into (one per thread).
+    type Sum: Send;
+    /// A fresh accumulator.
+    fn start(&self) -> Self::Sum;
+    /// Adds the edge `from` → `to` to `sum`.
+    fn visit(&self, sum: &mut Self::Sum, from: u32, to: u32, left: [f64; 2], right: [f64; 2]);
+}
+
+/// The circumcentre of each triangle of `triangles` (vertex triples).
+fn circumcentres(points: &[[f64; 2]], triangles: &[u32]) -> Vec<[f64; 2]> {
+    triangles
+        .chunks_exact(3)
+        .map(|t| {
+            circumcentre(
+                points[t[0] as usize],
+                points[t[1] as usize],
+                points[t[2] as usize],
+            )
+        })
+        .collect()
 }
 
 /// The halfedge after `e` in its triangle.
@@ -121,7 +146,6 @@ pub(crate) fn triangulate_in_polygon(
     Some(Triangulation {
         triangles,
         halfedges,
-        circumcentres: Vec::new(),
     })
 }
 
@@ -191,24 +215,37 @@ const SPLIT_MIN_POINTS: usize = 4096;
 /// point is inserted in [`brio_order`]. With two or more threads and enough
 /// points, the two halves left and right of a vertical line are
 /// triangulated in parallel and merged ([`triangulate_in_polygon_split`]);
-/// the result may then contain unused triangle slots. `None` as for
-/// [`triangulate_in_polygon`].
-pub(crate) fn triangulate_spatially_ordered(
+/// the result may then contain unused triangle slots. Every Delaunay
+/// triangle is handed to `visitor` once, on the thread that made it; the
+/// accumulators are returned in a fixed order (so their combination does
+/// not depend on scheduling). `None` as for [`triangulate_in_polygon`].
+pub(crate) fn triangulate_spatially_ordered<V: EdgeVisitor>(
     points: &[[f64; 2]],
     corners: usize,
-) -> Option<Triangulation> {
+    visitor: &V,
+) -> Option<(Triangulation, Vec<V::Sum>)> {
     let inner = points.len().saturating_sub(corners);
     if inner >= SPLIT_MIN_POINTS
         && rayon::current_num_threads() >= 2
-        && let Some(tri) = triangulate_in_polygon_split(points, corners)
+        && let Some(result) = triangulate_in_polygon_split(points, corners, visitor)
     {
-        return Some(tri);
+        return Some(result);
     }
     let order: Vec<u32> = brio_order(inner)
         .into_iter()
         .map(|k| k + corners as u32)
         .collect();
-    triangulate_in_polygon(points, corners, &order)
+    let tri = triangulate_in_polygon(points, corners, &order)?;
+    let centres = circumcentres(points, &tri.triangles);
+    let mut sum = visitor.start();
+    for (e, &twin) in tri.halfedges.iter().enumerate() {
+        if twin != NONE && twin as usize > e {
+            let (from, to) = (tri.triangles[e], tri.triangles[next(e as u32) as usize]);
+            let (left, right) = (centres[e / 3], centres[twin as usize / 3]);
+            visitor.visit(&mut sum, from, to, left, right);
+        }
+    }
+    Some((tri, vec![sum]))
 }
 
 /// What the merge needs from one half's Delaunay triangulation (made with
@@ -225,15 +262,18 @@ struct Half {
     /// triangle not kept: the edges between the kept part and the seam
     /// region.
     boundary: Vec<u32>,
+    /// The circumcentre of each boundary halfedge's (kept) triangle.
+    boundary_centres: Vec<[f64; 2]>,
 }
 
 /// Triangulates the polygon's corners and `members` (one half's points,
 /// ascending, i.e. in spatial order) into `triangles` and `halfedges`,
 /// which start at halfedge `offset` of the merged numbering, and keeps
 /// the triangles whose vertices and circumcircle lie strictly left
-/// (`left`) or right of the line x = `split`.
+/// (`left`) or right of the line x = `split`, handing the edges between
+/// two kept triangles to `visitor`.
 #[allow(clippy::too_many_arguments)]
-fn triangulate_half(
+fn triangulate_half<V: EdgeVisitor>(
     points: &[[f64; 2]],
     corners: usize,
     members: &[u32],
@@ -241,8 +281,9 @@ fn triangulate_half(
     left: bool,
     triangles: &mut [u32],
     halfedges: &mut [u32],
-    centres: &mut [[f64; 2]],
     offset: u32,
+    visitor: &V,
+    sum: &mut V::Sum,
 ) -> Option<Half> {
     let order: Vec<u32> = brio_order(members.len())
         .into_iter()
@@ -251,33 +292,48 @@ fn triangulate_half(
     triangulate_into(points, corners, &order, triangles, halfedges)?;
     // Signed distance beyond the line, positive on this half's side.
     let beyond = |x: f64| if left { split - x } else { x - split };
-    let kept: Vec<bool> = triangles
+    // The circumcentre of each kept triangle, NaN for the others.
+    let centres: Vec<[f64; 2]> = triangles
         .chunks_exact(3)
-        .zip(centres.iter_mut())
-        .map(|(t, centre)| {
+        .map(|t| {
             let [a, b, c] = [t[0], t[1], t[2]].map(|i| points[i as usize]);
             if !(beyond(a[0]) > 0.0 && beyond(b[0]) > 0.0 && beyond(c[0]) > 0.0) {
-                return false;
+                return [f64::NAN; 2];
             }
             // The circle clear of the line, with a margin for rounding (a
-            // wrong call here is caught by the merge's checks). The centre
-            // is kept for the Voronoi cells.
-            *centre = circumcentre(a, b, c);
+            // wrong call here is caught by the merge's checks, and the
+            // visitor's sums are then thrown away).
+            let centre = circumcentre(a, b, c);
             let radius2 = (centre[0] - a[0]).powi(2) + (centre[1] - a[1]).powi(2);
             let gap = beyond(centre[0]);
-            gap > 0.0 && gap * gap > radius2 * (1.0 + 1e-9)
+            if gap > 0.0 && gap * gap > radius2 * (1.0 + 1e-9) {
+                centre
+            } else {
+                [f64::NAN; 2]
+            }
         })
         .collect();
+    let is_kept = |t: usize| !centres[t][0].is_nan();
+    let mut kept = 0;
     let mut seen = vec![false; points.len()];
     let mut seam = Vec::new();
     let mut boundary = Vec::new();
-    for (t, &is_kept) in kept.iter().enumerate() {
+    let mut boundary_centres = Vec::new();
+    for t in 0..centres.len() {
         let slots = 3 * t..3 * t + 3;
-        if is_kept {
+        if is_kept(t) {
+            kept += 1;
             for e in slots {
-                let twin = halfedges[e];
-                if twin != NONE && !kept[twin as usize / 3] {
+                let twin = halfedges[e] as usize;
+                if twin == NONE as usize {
+                    continue;
+                }
+                if !is_kept(twin / 3) {
                     boundary.push(e as u32 + offset);
+                    boundary_centres.push(centres[t]);
+                } else if twin > e {
+                    let (from, to) = (triangles[e], triangles[next(e as u32) as usize]);
+                    visitor.visit(sum, from, to, centres[t], centres[twin / 3]);
                 }
             }
         } else {
@@ -297,9 +353,10 @@ fn triangulate_half(
         }
     }
     Some(Half {
-        kept: kept.iter().filter(|&&k| k).count(),
+        kept,
         seam,
         boundary,
+        boundary_centres,
     })
 }
 
@@ -340,10 +397,11 @@ pub(crate) fn circumcentre(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> [f64; 2] {
 /// Delaunay by construction, the result is then locally Delaunay
 /// everywhere, hence a Delaunay triangulation of all the points. The
 /// halves' triangles not kept stay as unused slots ([`NONE`] vertices).
-pub(crate) fn triangulate_in_polygon_split(
+pub(crate) fn triangulate_in_polygon_split<V: EdgeVisitor>(
     points: &[[f64; 2]],
     corners: usize,
-) -> Option<Triangulation> {
+    visitor: &V,
+) -> Option<(Triangulation, Vec<V::Sum>)> {
     if corners < 3 || points.len() < corners + 2 || points.len() >= (NONE / 8) as usize {
         return None;
     }
@@ -367,22 +425,27 @@ pub(crate) fn triangulate_in_polygon_split(
     let slots_all = 3 * triangle_count(corners, points.len() - corners);
     let mut triangles = vec![0u32; slots_a + slots_b + slots_all];
     let mut halfedges = vec![0u32; slots_a + slots_b + slots_all];
-    let mut centres = vec![[0.0; 2]; (slots_a + slots_b + slots_all) / 3];
     triangles.truncate(slots_a + slots_b);
     halfedges.truncate(slots_a + slots_b);
-    centres.truncate((slots_a + slots_b) / 3);
-    let (a, b) = {
+    let ((a, mut sum_a), (b, sum_b)) = {
         let (triangles_a, triangles_b) = triangles.split_at_mut(slots_a);
         let (halfedges_a, halfedges_b) = halfedges.split_at_mut(slots_a);
-        let (centres_a, centres_b) = centres.split_at_mut(slots_a / 3);
         rayon::join(
             || {
-                let (t, h, c) = (triangles_a, halfedges_a, centres_a);
-                triangulate_half(points, corners, &left, split, true, t, h, c, 0)
+                let mut sum = visitor.start();
+                let (t, h) = (triangles_a, halfedges_a);
+                let half = triangulate_half(
+                    points, corners, &left, split, true, t, h, 0, visitor, &mut sum,
+                );
+                (half, sum)
             },
             || {
-                let (t, h, c, offset) = (triangles_b, halfedges_b, centres_b, slots_a as u32);
-                triangulate_half(points, corners, &right, split, false, t, h, c, offset)
+                let mut sum = visitor.start();
+                let (t, h, offset) = (triangles_b, halfedges_b, slots_a as u32);
+                let half = triangulate_half(
+                    points, corners, &right, split, false, t, h, offset, visitor, &mut sum,
+                );
+                (half, sum)
             },
         )
     };
@@ -408,6 +471,7 @@ pub(crate) fn triangulate_in_polygon_split(
     // Pair each boundary halfedge with its twin in the seam triangulation
     // (`partner`, merged numbering), checking the in-circle test.
     let mut partner = vec![NONE; gap.triangles.len()];
+    let mut paired = Vec::with_capacity(a.boundary.len() + b.boundary.len());
     let pt = |i: u32| points[i as usize];
     for &e in a.boundary.iter().chain(&b.boundary) {
         let u = triangles[e as usize];
@@ -419,6 +483,7 @@ pub(crate) fn triangulate_in_polygon_split(
             return None;
         }
         partner[g as usize] = e;
+        paired.push(g);
         let d = gap.triangles[prev(g) as usize];
         if in_circle(pt(u), pt(v), pt(w), pt(d)) > 0.0 {
             return None;
@@ -457,12 +522,36 @@ pub(crate) fn triangulate_in_polygon_split(
         return None;
     }
 
+    // The dual Voronoi edges of the seam's edges: those shared with a kept
+    // triangle, then those between two seam triangles.
+    let seam_centres: Vec<[f64; 2]> = inside
+        .iter()
+        .map(|&t| {
+            let v = &gap.triangles[3 * t as usize..3 * t as usize + 3];
+            circumcentre(pt(v[0]), pt(v[1]), pt(v[2]))
+        })
+        .collect();
+    let centre_of = |g: u32| seam_centres[new_index[g as usize / 3] as usize];
+    let boundary_centres = a.boundary_centres.iter().chain(&b.boundary_centres);
+    let boundary = a.boundary.iter().chain(&b.boundary);
+    for ((&e, &left), &g) in boundary.zip(boundary_centres).zip(&paired) {
+        let (from, to) = (triangles[e as usize], triangles[next(e) as usize]);
+        visitor.visit(&mut sum_a, from, to, left, centre_of(g));
+    }
+    for &t in &inside {
+        for g in 3 * t..3 * t + 3 {
+            let twin = gap.halfedges[g as usize];
+            if partner[g as usize] == NONE && twin != NONE && twin > g {
+                let (from, to) = (gap.triangles[g as usize], gap.triangles[next(g) as usize]);
+                visitor.visit(&mut sum_a, from, to, centre_of(g), centre_of(twin));
+            }
+        }
+    }
+
     // Append the seam triangles and link them to the kept ones.
     let first = triangles.len() as u32;
     let merged = |g: u32| first + 3 * new_index[g as usize / 3] + g % 3;
     for &t in &inside {
-        let v = &gap.triangles[3 * t as usize..3 * t as usize + 3];
-        centres.push(circumcentre(pt(v[0]), pt(v[1]), pt(v[2])));
         for g in 3 * t..3 * t + 3 {
             triangles.push(gap.triangles[g as usize]);
             let p = partner[g as usize];
@@ -481,11 +570,13 @@ pub(crate) fn triangulate_in_polygon_split(
             halfedges[p as usize] = merged(g as u32);
         }
     }
-    Some(Triangulation {
-        triangles,
-        halfedges,
-        circumcentres: centres,
-    })
+    Some((
+        Triangulation {
+            triangles,
+            halfedges,
+        },
+        vec![sum_a, sum_b],
+    ))
 }
 
 /// A biased randomised insertion order (BRIO) of `count` points given in
@@ -790,10 +881,30 @@ mod tests {
             .num_threads(2)
             .build()
             .unwrap();
-        let tri = pool
-            .install(|| triangulate_in_polygon_split(&points, 4))
+        let (tri, counts) = pool
+            .install(|| triangulate_in_polygon_split(&points, 4, &Count))
             .unwrap_or_else(|| panic!("{name}: the split triangulation gave up"));
         check_delaunay(&points, 4, &tri);
+        // The visitor saw each inner edge once: three per triangle, less
+        // the polygon's four sides, counted twice.
+        assert_eq!(
+            2 * counts.iter().sum::<usize>(),
+            3 * triangle_count(4, points.len() - 4) - 4,
+            "{name}"
+        );
+    }
+
+    /// A visitor that only counts.
+    struct Count;
+
+    impl EdgeVisitor for Count {
+        type Sum = usize;
+        fn start(&self) -> usize {
+            0
+        }
+        fn visit(&self, sum: &mut usize, _: u32, _: u32, _: [f64; 2], _: [f64; 2]) {
+            *sum += 1;
+        }
     }
 
     fn xorshift(state: &mut u64) -> f64 {

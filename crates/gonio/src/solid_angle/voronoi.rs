@@ -42,7 +42,7 @@ use std::collections::HashMap;
 use delaunator::{EMPTY, Point, next_halfedge, triangulate};
 use rayon::prelude::*;
 
-use super::delaunay::{self, NONE, Triangulation, circumcentre};
+use super::delaunay::{self, circumcentre};
 use crate::measurement::Hemisphere;
 
 /// Radius of the equal-area disk that one hemisphere maps to (√2).
@@ -121,10 +121,7 @@ pub fn disk_voronoi_areas(points: &[[f64; 2]]) -> Vec<f64> {
         group_of[i as usize] = g as u32;
         group_size[g] += 1;
     }
-    let Some(tri) = delaunay::triangulate_spatially_ordered(&vertices, GHOSTS) else {
-        return reference_disk_voronoi_areas(points);
-    };
-    let Some(cell_areas) = cell_areas(&vertices, &tri) else {
+    let Some(cell_areas) = cell_areas(&vertices) else {
         return reference_disk_voronoi_areas(points);
     };
     group_of
@@ -210,78 +207,58 @@ fn ghost_ring() -> impl Iterator<Item = [f64; 2]> {
     })
 }
 
-/// Disk-clipped Voronoi cell areas of the non-ghost vertices, in order, or
-/// `None` if one is not finite (never seen).
+/// Sums the disk-clipped Voronoi cells of the triangulation's vertices
+/// edge by edge.
 ///
 /// A vertex's cell is the polygon of the circumcentres of its triangles,
 /// and each of its edges is dual to one of the vertex's Delaunay edges.
 /// The clipped area is a sum over the polygon's edges (the signed area of
-/// the triangle from the origin to the edge, clipped to the disk), so it is
-/// summed edge by edge: each Delaunay edge u–v once, its term added to u's
-/// cell and subtracted from v's. These loads are independent, where walking
-/// around each vertex chases one pointer per corner. The edges are summed
-/// in a fixed number of parts, added in a fixed order, so the result does
-/// not depend on the thread count or scheduling.
-fn cell_areas(vertices: &[[f64; 2]], tri: &Triangulation) -> Option<Vec<f64>> {
-    // Two parts: both cores busy, and each part costs a zeroed array per vertex.
-    const PARTS: usize = 2;
-    let computed: Vec<[f64; 2]>;
-    let circumcentres = if tri.circumcentres.len() == tri.triangles.len() / 3 {
-        &tri.circumcentres
-    } else {
-        computed = tri
-            .triangles
-            .par_chunks_exact(3)
-            .with_min_len(4096)
-            .map(|t| {
-                if t[0] == NONE {
-                    return [f64::NAN; 2]; // an unused slot
-                }
-                circumcentre(
-                    vertices[t[0] as usize],
-                    vertices[t[1] as usize],
-                    vertices[t[2] as usize],
-                )
-            })
-            .collect();
-        &computed
-    };
-    let triangle_slots = tri.triangles.len() / 3;
-    let per_part = triangle_slots.div_ceil(PARTS);
-    let r2 = DISK_RADIUS * DISK_RADIUS;
-    let parts: Vec<Vec<f64>> = (0..PARTS)
-        .into_par_iter()
-        .map(|part| {
-            let mut sums = vec![0.0; vertices.len()];
-            let slots = part * per_part..((part + 1) * per_part).min(triangle_slots);
-            for e in 3 * slots.start..3 * slots.end {
-                let twin = tri.halfedges[e];
-                // Each edge once; none on the hull (ghost to ghost) or in
-                // unused slots.
-                if twin == NONE || (twin as usize) < e || tri.triangles[e] == NONE {
-                    continue;
-                }
-                let (u, v) = (
-                    tri.triangles[e],
-                    tri.triangles[delaunay::next(e as u32) as usize],
-                );
-                let (a, b) = (circumcentres[e / 3], circumcentres[twin as usize / 3]);
-                let inside = a[0] * a[0] + a[1] * a[1] <= r2 && b[0] * b[0] + b[1] * b[1] <= r2;
-                let area = if inside {
-                    0.5 * (a[0] * b[1] - a[1] * b[0])
-                } else {
-                    disk_triangle_area(a, b, DISK_RADIUS)
-                };
-                sums[u as usize] += area;
-                sums[v as usize] -= area;
-            }
-            sums
-        })
-        .collect();
+/// the triangle from the origin to the edge, clipped to the disk), so each
+/// Delaunay edge u → v adds its term to u's cell and subtracts it from
+/// v's. The triangulation hands each edge over on the thread that made it,
+/// right after it computed the two circumcentres: no second pass, no
+/// stored centres.
+struct CellSums {
+    vertices: usize,
+}
+
+impl delaunay::EdgeVisitor for CellSums {
+    type Sum = Vec<f64>;
+
+    fn start(&self) -> Vec<f64> {
+        vec![0.0; self.vertices]
+    }
+
+    #[inline]
+    fn visit(&self, sums: &mut Vec<f64>, from: u32, to: u32, a: [f64; 2], b: [f64; 2]) {
+        let r2 = DISK_RADIUS * DISK_RADIUS;
+        let inside = a[0] * a[0] + a[1] * a[1] <= r2 && b[0] * b[0] + b[1] * b[1] <= r2;
+        let area = if inside {
+            0.5 * (a[0] * b[1] - a[1] * b[0])
+        } else {
+            disk_triangle_area(a, b, DISK_RADIUS)
+        };
+        sums[from as usize] += area;
+        sums[to as usize] -= area;
+    }
+}
+
+/// Disk-clipped Voronoi cell areas of the non-ghost vertices, in order, or
+/// `None` if the triangulation gave up or a cell is not finite (never
+/// seen). The per-thread sums are added in a fixed order, so the result
+/// does not depend on scheduling.
+fn cell_areas(vertices: &[[f64; 2]]) -> Option<Vec<f64>> {
+    let (_, sums) = delaunay::triangulate_spatially_ordered(
+        vertices,
+        GHOSTS,
+        &CellSums {
+            vertices: vertices.len(),
+        },
+    )?;
     let areas: Vec<f64> = (GHOSTS..vertices.len())
         .into_par_iter()
         .with_min_len(4096)
-        .map(|i| parts.iter().map(|sums| sums[i]).sum::<f64>().abs())
+        .map(|i| sums.iter().map(|part| part[i]).sum::<f64>().abs())
         .collect();
     areas.iter().all(|a| a.is_finite()).then_some(areas)
 }
