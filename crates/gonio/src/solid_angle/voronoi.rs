@@ -130,13 +130,15 @@ pub fn disk_voronoi_areas(points: &[[f64; 2]]) -> Vec<f64> {
         .collect()
 }
 
+/// Bits per coordinate of the Hilbert key.
+const HILBERT_LEVELS: u32 = 16;
+
 /// The indices of `points` (all finite) in Hilbert-curve order over their
 /// bounding box, ties (the same curve cell) broken by the coordinates, so
 /// that coincident points are adjacent and the order does not depend on the
 /// input order except among coincident points.
 fn hilbert_order(points: &[[f64; 2]]) -> Vec<u32> {
-    const LEVELS: u32 = 16;
-    let side = ((1u32 << LEVELS) - 1) as f64;
+    let side = ((1u32 << HILBERT_LEVELS) - 1) as f64;
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
     for p in points {
         for k in 0..2 {
@@ -145,17 +147,17 @@ fn hilbert_order(points: &[[f64; 2]]) -> Vec<u32> {
         }
     }
     let scale = side / (hi[0] - lo[0]).max(hi[1] - lo[1]).max(f64::MIN_POSITIVE);
-    let mut keyed: Vec<u64> = points
+    let keyed: Vec<u64> = points
         .par_iter()
         .with_min_len(4096)
         .enumerate()
         .map(|(i, p)| {
             let x = ((p[0] - lo[0]) * scale) as u32;
             let y = ((p[1] - lo[1]) * scale) as u32;
-            (hilbert_index(x, y, LEVELS) << 32) | i as u64
+            (u64::from(hilbert_key(x, y)) << 32) | i as u64
         })
         .collect();
-    keyed.par_sort_unstable();
+    let keyed = sort_by_high_half(keyed);
     let mut order: Vec<u32> = keyed.iter().map(|&k| k as u32).collect();
     // Points in the same curve cell: order them by their coordinates.
     let mut start = 0;
@@ -176,26 +178,88 @@ fn hilbert_order(points: &[[f64; 2]]) -> Vec<u32> {
     order
 }
 
-/// Position of the cell `(x, y)` along the Hilbert curve that fills a
-/// `2^levels` square.
-fn hilbert_index(mut x: u32, mut y: u32, levels: u32) -> u64 {
-    let n = 1u32 << levels;
-    let mut d = 0u64;
-    let mut s = n / 2;
-    while s > 0 {
-        let rx = u32::from(x & s != 0);
-        let ry = u32::from(y & s != 0);
-        d += u64::from(s) * u64::from(s) * u64::from((3 * rx) ^ ry);
-        if ry == 0 {
-            if rx == 1 {
-                x = n - 1 - x;
-                y = n - 1 - y;
-            }
-            std::mem::swap(&mut x, &mut y);
+/// `keys` sorted by their upper 32 bits, stably (a least-significant-digit
+/// radix sort, three passes of 11 bits): a few linear passes where a
+/// comparison sort costs log n.
+fn sort_by_high_half(mut keys: Vec<u64>) -> Vec<u64> {
+    const BITS: u32 = 11;
+    const BUCKETS: usize = 1 << BITS;
+    let digit = |key: u64, pass: u32| ((key >> (32 + BITS * pass)) as usize) & (BUCKETS - 1);
+    let mut counts = vec![[0usize; BUCKETS]; 3];
+    for &key in &keys {
+        for (pass, count) in counts.iter_mut().enumerate() {
+            count[digit(key, pass as u32)] += 1;
         }
-        s /= 2;
     }
-    d
+    let mut spare = vec![0u64; keys.len()];
+    for (pass, count) in counts.iter().enumerate() {
+        // A digit shared by every key: nothing to do.
+        if count.contains(&keys.len()) {
+            continue;
+        }
+        let mut next = [0usize; BUCKETS];
+        let mut total = 0;
+        for (slot, &c) in next.iter_mut().zip(count) {
+            *slot = total;
+            total += c;
+        }
+        for &key in &keys {
+            let d = digit(key, pass as u32);
+            spare[next[d]] = key;
+            next[d] += 1;
+        }
+        std::mem::swap(&mut keys, &mut spare);
+    }
+    keys
+}
+
+/// For the Hilbert curve: per state (bit 0: the quadrant's axes are
+/// swapped, bit 1: complemented) and 4 bits each of x (high nibble) and y,
+/// the curve's 8 bits for those 4 levels and, above them, the state for the
+/// levels below.
+static HILBERT_TABLE: [u16; 1024] = hilbert_table();
+
+const fn hilbert_table() -> [u16; 1024] {
+    let mut table = [0u16; 1024];
+    let mut entry = 0;
+    while entry < 1024 {
+        let (state, x, y) = (entry >> 8, (entry >> 4) & 15, entry & 15);
+        let (mut swap, mut complement) = (state & 1, state >> 1);
+        let mut digits = 0;
+        let mut level = 4;
+        while level > 0 {
+            level -= 1;
+            let (mut bx, mut by) = ((x >> level) & 1, (y >> level) & 1);
+            if swap == 1 {
+                (bx, by) = (by, bx);
+            }
+            let (rx, ry) = (bx ^ complement, by ^ complement);
+            digits = (digits << 2) | ((3 * rx) ^ ry);
+            // The sub-square's curve is the transpose, mirrored in the
+            // third quadrant.
+            if ry == 0 {
+                complement ^= rx;
+                swap ^= 1;
+            }
+        }
+        table[entry] = (digits | ((swap | (complement << 1)) << 8)) as u16;
+        entry += 1;
+    }
+    table
+}
+
+/// Position of the cell `(x, y)` along the Hilbert curve that fills the
+/// `2^16` square, four levels per table look-up.
+fn hilbert_key(x: u32, y: u32) -> u32 {
+    let mut state = 0usize;
+    let mut key = 0u32;
+    for shift in [12, 8, 4, 0] {
+        let nibbles = (((x >> shift) & 15) << 4 | ((y >> shift) & 15)) as usize;
+        let entry = HILBERT_TABLE[(state << 8) | nibbles];
+        key = (key << 8) | u32::from(entry & 0xff);
+        state = usize::from(entry >> 8);
+    }
+    key
 }
 
 /// The ghost points closing the outer cells, counter-clockwise.
@@ -468,6 +532,80 @@ fn disk_triangle_area(a: [f64; 2], b: [f64; 2], r: f64) -> f64 {
 mod tests {
     use super::*;
     use std::f64::consts::PI;
+
+    /// The Hilbert curve one level at a time, as defined: the quadrant's
+    /// digit, then the transform of the sub-square's coordinates.
+    fn hilbert_index_per_level(mut x: u32, mut y: u32, levels: u32) -> u64 {
+        let n = 1u32 << levels;
+        let mut d = 0u64;
+        let mut s = n / 2;
+        while s > 0 {
+            let rx = u32::from(x & s != 0);
+            let ry = u32::from(y & s != 0);
+            d += u64::from(s) * u64::from(s) * u64::from((3 * rx) ^ ry);
+            if ry == 0 {
+                if rx == 1 {
+                    x = n - 1 - x;
+                    y = n - 1 - y;
+                }
+                std::mem::swap(&mut x, &mut y);
+            }
+            s /= 2;
+        }
+        d
+    }
+
+    #[test]
+    fn hilbert_keys_follow_the_curve() {
+        // Every cell of a 2^6 corner, then scattered cells of the full square.
+        for x in 0..64 {
+            for y in 0..64 {
+                assert_eq!(
+                    u64::from(hilbert_key(x, y)),
+                    hilbert_index_per_level(x, y, HILBERT_LEVELS)
+                );
+            }
+        }
+        let mut state = 0x9e37_79b9u32;
+        for _ in 0..100_000 {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            let (x, y) = (state >> 16, state & 0xffff);
+            assert_eq!(
+                u64::from(hilbert_key(x, y)),
+                hilbert_index_per_level(x, y, HILBERT_LEVELS)
+            );
+        }
+        // The curve is continuous: consecutive keys are neighbouring cells.
+        let mut cells = vec![(0, 0); 1 << 12];
+        for x in 0..64u32 {
+            for y in 0..64u32 {
+                let k = hilbert_key(x << 10, y << 10) >> 20;
+                cells[k as usize] = (x, y);
+            }
+        }
+        for w in cells.windows(2) {
+            assert_eq!(w[0].0.abs_diff(w[1].0) + w[0].1.abs_diff(w[1].1), 1);
+        }
+    }
+
+    #[test]
+    fn radix_sort_orders_by_the_high_half_stably() {
+        let mut state = 0x1234_5678_9abc_def0u64;
+        let keys: Vec<u64> = (0..50_000u64)
+            .map(|i| {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                // Few distinct high halves, so many ties.
+                ((state % 3000) << 32) | i
+            })
+            .collect();
+        let mut expected = keys.clone();
+        expected.sort_by_key(|k| k >> 32);
+        assert_eq!(sort_by_high_half(keys), expected);
+    }
 
     #[test]
     fn disk_clipping_of_simple_shapes() {
