@@ -665,27 +665,30 @@ impl Inserter<'_> {
     }
 
     /// The triangle containing `point` (inside or on its boundary), by a
-    /// visibility walk from triangle `start` that crosses any edge `point` lies
-    /// strictly beyond, trying the edges in turn after the one it came in by.
+    /// visibility walk from triangle `start` that crosses any edge `point`
+    /// lies strictly beyond, trying the edges in turn after the one it came
+    /// in by (which `point` is known to lie beyond, so is not tried again).
     fn locate(&self, start: u32, point: [f64; 2]) -> Option<u32> {
         let (triangles, halfedges) = (&*self.triangles, &*self.halfedges);
+        let pt = |e: u32| self.points[triangles[e as usize] as usize];
         let mut t = start;
-        let mut entry = 0u32;
+        let (mut first, mut count) = (3 * t, 3);
         // A Delaunay walk visits each triangle at most once.
         'walk: for _ in 0..=self.used / 3 {
-            for k in 0..3 {
-                let e = 3 * t + (entry + k) % 3;
-                let a = self.points[triangles[e as usize] as usize];
-                let b = self.points[triangles[next(e) as usize] as usize];
+            let mut e = first;
+            let mut a = pt(e);
+            for _ in 0..count {
+                let b = pt(next(e));
                 if orient(a, b, point) < 0.0 {
                     let twin = halfedges[e as usize];
                     if twin == NONE {
                         return None; // outside the polygon
                     }
                     t = twin / 3;
-                    entry = twin % 3 + 1;
+                    (first, count) = (next(twin), 2);
                     continue 'walk;
                 }
+                (e, a) = (next(e), b);
             }
             return Some(t);
         }
