@@ -677,7 +677,10 @@ impl Inserter<'_> {
         'walk: for _ in 0..=self.used / 3 {
             let mut e = first;
             let mut a = pt(e);
-            for _ in 0..count {
+            for k in 0..3 {
+                if k == count {
+                    break;
+                }
                 let b = pt(next(e));
                 if orient(a, b, point) < 0.0 {
                     let twin = halfedges[e as usize];
