@@ -190,17 +190,41 @@ fn triangulate_into(
         triangle_of[k as usize] = k - 1;
         triangle_of[k as usize + 1] = k - 1;
     }
+    let mut mesh = Vec::with_capacity(len / 3);
+    for t in 0..fan as usize {
+        let mut record = [0; 8];
+        for k in 0..3 {
+            record[k] = triangles[3 * t + k];
+            let twin = halfedges[3 * t + k];
+            record[4 + k] = if twin == NONE {
+                NONE
+            } else {
+                4 * (twin / 3) + twin % 3
+            };
+        }
+        mesh.push(record);
+    }
     let mut inserter = Inserter {
         points,
-        triangles,
-        halfedges,
-        used: 3 * fan as usize,
+        mesh,
         stack: Vec::with_capacity(64),
         last: 0,
         triangle_of,
     };
     for &p in order {
         inserter.insert(p)?;
+    }
+    // Back to the flat layout, halfedge 3t + k.
+    for (t, record) in inserter.mesh.iter().enumerate() {
+        triangles[3 * t..3 * t + 3].copy_from_slice(&record[..3]);
+        for k in 0..3 {
+            let twin = record[4 + k];
+            halfedges[3 * t + k] = if twin == NONE {
+                NONE
+            } else {
+                3 * (twin >> 2) + (twin & 3)
+            };
+        }
     }
     Some(())
 }
@@ -622,14 +646,27 @@ pub(crate) fn brio_order(count: usize) -> Vec<u32> {
     order
 }
 
+/// The halfedge after `e` in its triangle, in the inserter's numbering.
+#[inline]
+fn next4(e: u32) -> u32 {
+    if e & 3 == 2 { e - 2 } else { e + 1 }
+}
+
+/// The halfedge before `e` in its triangle, in the inserter's numbering.
+#[inline]
+fn prev4(e: u32) -> u32 {
+    if e & 3 == 0 { e + 2 } else { e - 1 }
+}
+
+/// Incremental insertion into a triangulation held as one 32-byte record
+/// per triangle (its three vertices, a spare, its three halfedges' twins,
+/// a spare), so that a step of the walk or a flip touches one cache line
+/// per triangle instead of one in each of two arrays. Halfedge k of
+/// triangle t is numbered 4t + k here.
 struct Inserter<'a> {
     points: &'a [[f64; 2]],
-    /// The triangles' vertices (see [`Triangulation`]); the first `used`
-    /// entries are filled.
-    triangles: &'a mut [u32],
-    /// The halfedges' twins, parallel to `triangles`.
-    halfedges: &'a mut [u32],
-    used: usize,
+    /// The triangles made so far.
+    mesh: Vec<[u32; 8]>,
     /// Halfedges waiting for the in-circle test.
     stack: Vec<u32>,
     /// A triangle touching the previously inserted point: the walk's start
@@ -640,6 +677,28 @@ struct Inserter<'a> {
 }
 
 impl Inserter<'_> {
+    /// The vertex halfedge `e` starts from.
+    #[inline]
+    fn vertex(&self, e: u32) -> u32 {
+        self.mesh[(e >> 2) as usize][(e & 3) as usize]
+    }
+
+    /// The twin of halfedge `e`, or [`NONE`].
+    #[inline]
+    fn twin(&self, e: u32) -> u32 {
+        self.mesh[(e >> 2) as usize][4 + (e & 3) as usize]
+    }
+
+    #[inline]
+    fn set_vertex(&mut self, e: u32, v: u32) {
+        self.mesh[(e >> 2) as usize][(e & 3) as usize] = v;
+    }
+
+    #[inline]
+    fn point(&self, v: u32) -> [f64; 2] {
+        self.points[v as usize]
+    }
+
     /// Inserts point `p`. The walk starts next to p's neighbour in the
     /// spatial order (the points' indices) when that one is already in:
     /// a step or two away, where the previous point of the same insertion
@@ -669,39 +728,39 @@ impl Inserter<'_> {
     /// lies strictly beyond, trying the edges in turn after the one it came
     /// in by (which `point` is known to lie beyond, so is not tried again).
     fn locate(&self, start: u32, point: [f64; 2]) -> Option<u32> {
-        let (triangles, halfedges) = (&*self.triangles, &*self.halfedges);
-        let pt = |e: u32| self.points[triangles[e as usize] as usize];
         let mut t = start;
-        let (mut first, mut count) = (3 * t, 3);
+        let (mut first, mut count) = (4 * t, 3);
         // A Delaunay walk visits each triangle at most once.
-        'walk: for _ in 0..=self.used / 3 {
+        'walk: for _ in 0..=self.mesh.len() {
+            let record = self.mesh[t as usize];
             let mut e = first;
-            let mut a = pt(e);
+            let mut a = self.point(record[(e & 3) as usize]);
             for k in 0..3 {
                 if k == count {
                     break;
                 }
-                let b = pt(next(e));
+                let b = self.point(record[(next4(e) & 3) as usize]);
                 if orient(a, b, point) < 0.0 {
-                    let twin = halfedges[e as usize];
+                    let twin = record[4 + (e & 3) as usize];
                     if twin == NONE {
                         return None; // outside the polygon
                     }
-                    t = twin / 3;
-                    (first, count) = (next(twin), 2);
+                    t = twin >> 2;
+                    (first, count) = (next4(twin), 2);
                     continue 'walk;
                 }
-                (e, a) = (next(e), b);
+                (e, a) = (next4(e), b);
             }
             return Some(t);
         }
         None
     }
 
+    #[inline]
     fn link(&mut self, a: u32, b: u32) {
-        self.halfedges[a as usize] = b;
+        self.mesh[(a >> 2) as usize][4 + (a & 3) as usize] = b;
         if b != NONE {
-            self.halfedges[b as usize] = a;
+            self.mesh[(b >> 2) as usize][4 + (b & 3) as usize] = a;
         }
     }
 
@@ -709,58 +768,50 @@ impl Inserter<'_> {
     /// and queues their outer edges. A point on an edge leaves one of them
     /// flat; the in-circle test of that edge always flips it away.
     fn split(&mut self, t: u32, p: u32) {
-        let base = 3 * t as usize;
-        let [a, b, c] = [
-            self.triangles[base],
-            self.triangles[base + 1],
-            self.triangles[base + 2],
-        ];
-        let twin_bc = self.halfedges[base + 1];
-        let twin_ca = self.halfedges[base + 2];
-        let t1 = (self.used / 3) as u32;
+        let record = self.mesh[t as usize];
+        let [a, b, c] = [record[0], record[1], record[2]];
+        let (twin_bc, twin_ca) = (record[5], record[6]);
+        let t1 = self.mesh.len() as u32;
         let t2 = t1 + 1;
-        self.triangles[base + 2] = p;
-        self.triangles[self.used..self.used + 6].copy_from_slice(&[b, c, p, c, a, p]);
-        self.halfedges[self.used..self.used + 6].fill(NONE);
-        self.used += 6;
+        self.mesh[t as usize][2] = p;
+        self.mesh.push([b, c, p, 0, NONE, NONE, NONE, 0]);
+        self.mesh.push([c, a, p, 0, NONE, NONE, NONE, 0]);
         self.triangle_of[c as usize] = t1;
         self.triangle_of[p as usize] = t;
         // (a, b, p): a→b keeps its twin.
-        self.link(3 * t + 1, 3 * t1 + 2); // b→p with p→b
-        self.link(3 * t + 2, 3 * t2 + 1); // p→a with a→p
-        self.link(3 * t1 + 1, 3 * t2 + 2); // c→p with p→c
-        self.link(3 * t1, twin_bc);
-        self.link(3 * t2, twin_ca);
-        self.stack.extend([3 * t, 3 * t1, 3 * t2]);
+        self.link(4 * t + 1, 4 * t1 + 2); // b→p with p→b
+        self.link(4 * t + 2, 4 * t2 + 1); // p→a with a→p
+        self.link(4 * t1 + 1, 4 * t2 + 2); // c→p with p→c
+        self.link(4 * t1, twin_bc);
+        self.link(4 * t2, twin_ca);
+        self.stack.extend([4 * t, 4 * t1, 4 * t2]);
     }
 
     /// Halfedge `e` = u→v lies in the triangle (u, v, p) of the newest point
     /// p. If the vertex d across it lies inside that triangle's circumcircle,
     /// flips u–v to p–d and queues the two edges now facing p.
     fn legalize(&mut self, e: u32) {
-        let twin = self.halfedges[e as usize];
+        let twin = self.twin(e);
         if twin == NONE {
             return;
         }
-        let tris = &*self.triangles;
-        let u = tris[e as usize];
-        let v = tris[next(e) as usize];
-        let p = tris[prev(e) as usize];
-        let d = tris[prev(twin) as usize];
-        let pt = |i: u32| self.points[i as usize];
-        if in_circle(pt(u), pt(v), pt(p), pt(d)) <= 0.0 {
+        let u = self.vertex(e);
+        let v = self.vertex(next4(e));
+        let p = self.vertex(prev4(e));
+        let d = self.vertex(prev4(twin));
+        if in_circle(self.point(u), self.point(v), self.point(p), self.point(d)) <= 0.0 {
             return;
         }
         // (u, v, p) and (v, u, d) become (u, d, p) and (v, p, d), keeping
         // the positions of their halfedges.
-        let (a0, a1) = (e, next(e));
-        let (b0, b1, b2) = (twin, next(twin), prev(twin));
-        let twin_a1 = self.halfedges[a1 as usize];
-        let twin_b1 = self.halfedges[b1 as usize];
-        self.triangles[a1 as usize] = d;
-        self.triangles[b1 as usize] = p;
-        self.triangle_of[u as usize] = e / 3;
-        self.triangle_of[v as usize] = twin / 3;
+        let (a0, a1) = (e, next4(e));
+        let (b0, b1, b2) = (twin, next4(twin), prev4(twin));
+        let twin_a1 = self.twin(a1);
+        let twin_b1 = self.twin(b1);
+        self.set_vertex(a1, d);
+        self.set_vertex(b1, p);
+        self.triangle_of[u as usize] = e >> 2;
+        self.triangle_of[v as usize] = twin >> 2;
         self.link(a0, twin_b1); // u→d
         self.link(b0, twin_a1); // v→p
         self.link(a1, b1); // d→p with p→d
