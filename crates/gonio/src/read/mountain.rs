@@ -293,6 +293,7 @@ impl DataRows<'_> {
     /// results and errors are the same as reading every line that way.
     fn read_into(mut self, samples: &mut Vec<Sample>, name: &Path) -> Result<(), ReadError> {
         let bytes = self.text.as_bytes();
+        self.read_halves(samples);
         loop {
             let (pos, rows) = match self.channels {
                 Channels::Y => plain_rows::<1>(bytes, self.pos, samples),
@@ -321,6 +322,49 @@ impl DataRows<'_> {
         }
     }
 }
+
+impl DataRows<'_> {
+    /// Reads the rows of a large file as two halves on two threads, split at
+    /// a line start: when the first half is plain to its end, both halves'
+    /// samples are kept and `self` moves past them; otherwise the second
+    /// half's work is dropped and nothing but the first half's plain rows
+    /// is kept, so [`DataRows::read_into`] goes on exactly as it would have.
+    fn read_halves(&mut self, samples: &mut Vec<Sample>) {
+        let bytes = self.text.as_bytes();
+        let rest = bytes.len() - self.pos;
+        if rest < PARALLEL_BYTES {
+            return;
+        }
+        let middle = self.pos + rest / 2;
+        let Some(split) = bytes[middle..]
+            .iter()
+            .position(|&b| b == b'\n')
+            .map(|at| middle + at + 1)
+        else {
+            return;
+        };
+        let channels = self.channels;
+        let rows = |slice: &[u8], from: usize, out: &mut Vec<Sample>| match channels {
+            Channels::Y => plain_rows::<1>(slice, from, out),
+            Channels::Xyz => plain_rows::<3>(slice, from, out),
+        };
+        let mut second = Vec::with_capacity(samples.capacity().saturating_sub(samples.len()) / 2);
+        let ((end, first_rows), (second_end, second_rows)) = rayon::join(
+            || rows(&bytes[..split], self.pos, samples),
+            || rows(bytes, split, &mut second),
+        );
+        self.pos = end;
+        self.lines_before += first_rows;
+        if end == split {
+            samples.append(&mut second);
+            self.pos = second_end;
+            self.lines_before += second_rows;
+        }
+    }
+}
+
+/// Files with more data bytes than this are read in two halves at once.
+const PARALLEL_BYTES: usize = 1 << 20;
 
 /// Reads plain rows of θ, φ and `VALUES` values from `bytes[pos..]` until
 /// one is not plain; returns where that row starts and how many rows were
@@ -450,5 +494,53 @@ mod tests {
         assert_eq!(parse_format_quantity("theta phi lux"), None);
         assert_eq!(parse_colorimetry("CIE-XYZ"), Some(Channels::Xyz));
         assert_eq!(unquote("\"Golden_glossy_paper\""), "Golden_glossy_paper");
+    }
+
+    /// A file of `rows` plain rows (above [`PARALLEL_BYTES`], so read in
+    /// two halves) with `odd` put in place of row `at` (0-based).
+    fn big_file(rows: usize, at: usize, odd: &str) -> String {
+        let mut text = String::from("#format: theta phi BRDF\n#intheta 30\n#inphi 0\n");
+        for i in 0..rows {
+            if i == at {
+                text.push_str(odd);
+            } else {
+                let theta = (i % 9000) as f64 * 0.01;
+                let phi = (i / 9000) as f64 * 7.5;
+                text.push_str(&format!("{theta}\t{phi}\t{}\n", i as f64 * 0.5));
+            }
+        }
+        text
+    }
+
+    #[test]
+    fn halves_read_as_one() {
+        let rows = 90_000;
+        let header_lines = 3;
+        let expected = |i: usize| i as f64 * 0.5;
+        // Plain throughout; an unusual row (CRLF, blank line, exponent) in
+        // either half; an error in either half keeps its line number.
+        for at in [rows / 4, 3 * rows / 4] {
+            let plain = parse(&big_file(rows, usize::MAX, ""), Path::new("t")).unwrap();
+            assert!(big_file(rows, usize::MAX, "").len() > PARALLEL_BYTES);
+            assert_eq!(plain.samples.len(), rows);
+            assert!(
+                plain
+                    .samples
+                    .iter()
+                    .enumerate()
+                    .all(|(i, s)| s.values[0] == expected(i))
+            );
+            for odd in ["1.5\t2.5\t7e0\r\n", "\n1.5\t2.5\t7\n"] {
+                let m = parse(&big_file(rows, at, odd), Path::new("t")).unwrap();
+                assert_eq!(m.samples.len(), rows, "{odd:?} at {at}");
+                assert_eq!(m.samples[at].values[0], 7.0);
+                assert_eq!(m.samples[at].theta_deg, 1.5);
+                for (i, s) in m.samples.iter().enumerate().filter(|&(i, _)| i != at) {
+                    assert_eq!(s.values[0], expected(i), "row {i}, {odd:?} at {at}");
+                }
+            }
+            let err = parse(&big_file(rows, at, "1.5\tx\t7\n"), Path::new("t")).unwrap_err();
+            assert_eq!(err.line(), Some(header_lines + at + 1), "error at row {at}");
+        }
     }
 }
