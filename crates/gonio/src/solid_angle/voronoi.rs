@@ -278,10 +278,11 @@ fn ghost_ring() -> impl Iterator<Item = [f64; 2]> {
 /// and each of its edges is dual to one of the vertex's Delaunay edges.
 /// The clipped area is a sum over the polygon's edges (the signed area of
 /// the triangle from the origin to the edge, clipped to the disk), so each
-/// Delaunay edge u → v adds its term to u's cell and subtracts it from
-/// v's. The triangulation hands each edge over on the thread that made it,
-/// right after it computed the two circumcentres: no second pass, no
-/// stored centres.
+/// Delaunay halfedge u → v adds to u's cell the term of its dual edge,
+/// from the circumcentre on its left to the one on its right. The
+/// triangulation hands the halfedges over on the thread that made them,
+/// right after it computed their triangles' circumcentres: no second pass
+/// over the triangulation.
 struct CellSums {
     vertices: usize,
 }
@@ -294,7 +295,7 @@ impl delaunay::EdgeVisitor for CellSums {
     }
 
     #[inline]
-    fn visit(&self, sums: &mut Vec<f64>, from: u32, to: u32, a: [f64; 2], b: [f64; 2]) {
+    fn visit(&self, sums: &mut Vec<f64>, from: u32, a: [f64; 2], b: [f64; 2]) {
         let r2 = DISK_RADIUS * DISK_RADIUS;
         let inside = a[0] * a[0] + a[1] * a[1] <= r2 && b[0] * b[0] + b[1] * b[1] <= r2;
         let area = if inside {
@@ -303,7 +304,6 @@ impl delaunay::EdgeVisitor for CellSums {
             disk_triangle_area(a, b, DISK_RADIUS)
         };
         sums[from as usize] += area;
-        sums[to as usize] -= area;
     }
 }
 
