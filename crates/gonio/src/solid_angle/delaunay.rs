@@ -233,27 +233,31 @@ fn triangulate_into(
 
 /// Below this many points (besides the corners) one thread triangulates
 /// them all: splitting costs a seam triangulation and a merge.
-const SPLIT_MIN_POINTS: usize = 4096;
+pub(crate) const SPLIT_MIN_POINTS: usize = 4096;
 
 /// Delaunay triangulation of `points`, whose first `corners` entries are the
 /// counter-clockwise corners of a convex polygon that strictly contains all
 /// the others, which must be distinct and in spatial (Hilbert) order. Each
-/// point is inserted in [`brio_order`]. With two or more threads and enough
-/// points, the two halves left and right of a vertical line are
-/// triangulated in parallel and merged ([`triangulate_in_polygon_split`]);
-/// the result may then contain unused triangle slots. Every Delaunay
-/// triangle is handed to `visitor` once, on the thread that made it; the
-/// accumulators are returned in a fixed order (so their combination does
-/// not depend on scheduling). `None` as for [`triangulate_in_polygon`].
+/// point is inserted in [`brio_order`]. With `halves` = `Some((left, x))`
+/// the other points are instead the `left` points with abscissa below `x`,
+/// in spatial order, then those at or beyond `x`, in spatial order; with
+/// two or more threads and enough points, the halves are triangulated in
+/// parallel and merged ([`triangulate_in_polygon_split`]), and the result
+/// may contain unused triangle slots. Every halfedge is handed to
+/// `visitor` once, on the thread that made it; the accumulators are
+/// returned in a fixed order (so their combination does not depend on
+/// scheduling). `None` as for [`triangulate_in_polygon`].
 pub(crate) fn triangulate_spatially_ordered<V: EdgeVisitor>(
     points: &[[f64; 2]],
     corners: usize,
+    halves: Option<(usize, f64)>,
     visitor: &V,
 ) -> Option<(Triangulation, Vec<V::Sum>)> {
     let inner = points.len().saturating_sub(corners);
-    if inner >= SPLIT_MIN_POINTS
+    if let Some((left, split)) = halves
+        && inner >= SPLIT_MIN_POINTS
         && rayon::current_num_threads() >= 2
-        && let Some(result) = triangulate_in_polygon_split(points, corners, visitor)
+        && let Some(result) = triangulate_in_polygon_split(points, corners, left, split, visitor)
     {
         return Some(result);
     }
@@ -292,7 +296,7 @@ struct Half {
 }
 
 /// Triangulates the polygon's corners and `members` (one half's points,
-/// ascending, i.e. in spatial order) into `triangles` and `halfedges`,
+/// in spatial order) into `triangles` and `halfedges`,
 /// which start at halfedge `offset` of the merged numbering, and keeps
 /// the triangles whose vertices and circumcircle lie strictly left
 /// (`left`) or right of the line x = `split`, handing the edges between
@@ -301,7 +305,7 @@ struct Half {
 fn triangulate_half<V: EdgeVisitor>(
     points: &[[f64; 2]],
     corners: usize,
-    members: &[u32],
+    members: std::ops::Range<u32>,
     split: f64,
     left: bool,
     triangles: &mut [u32],
@@ -310,13 +314,20 @@ fn triangulate_half<V: EdgeVisitor>(
     visitor: &V,
     sum: &mut V::Sum,
 ) -> Option<Half> {
-    let order: Vec<u32> = brio_order(members.len())
-        .into_iter()
-        .map(|k| members[k as usize])
-        .collect();
-    triangulate_into(points, corners, &order, triangles, halfedges)?;
     // Signed distance beyond the line, positive on this half's side.
     let beyond = |x: f64| if left { split - x } else { x - split };
+    let on_side = |p: &[f64; 2]| if left { p[0] < split } else { p[0] >= split };
+    if !points[members.start as usize..members.end as usize]
+        .iter()
+        .all(on_side)
+    {
+        return None;
+    }
+    let order: Vec<u32> = brio_order(members.len())
+        .into_iter()
+        .map(|k| members.start + k)
+        .collect();
+    triangulate_into(points, corners, &order, triangles, halfedges)?;
     // The circumcentre of each kept triangle, NaN for the others.
     let centres: Vec<[f64; 2]> = triangles
         .chunks_exact(3)
@@ -424,22 +435,19 @@ pub(crate) fn circumcentre(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> [f64; 2] {
 pub(crate) fn triangulate_in_polygon_split<V: EdgeVisitor>(
     points: &[[f64; 2]],
     corners: usize,
+    left_count: usize,
+    split: f64,
     visitor: &V,
 ) -> Option<(Triangulation, Vec<V::Sum>)> {
     if corners < 3 || points.len() < corners + 2 || points.len() >= (NONE / 8) as usize {
         return None;
     }
-    // The median abscissa of a sample: the halves need not be equal.
-    let inner = &points[corners..];
-    let stride = (inner.len() / 1024).max(1);
-    let mut sample: Vec<f64> = inner.iter().step_by(stride).map(|p| p[0]).collect();
-    sample.sort_unstable_by(f64::total_cmp);
-    let split = sample[sample.len() / 2];
-    let (left, right): (Vec<u32>, Vec<u32>) =
-        (corners as u32..points.len() as u32).partition(|&i| points[i as usize][0] < split);
-    if left.is_empty() || right.is_empty() {
+    let inner = points.len() - corners;
+    if left_count == 0 || left_count >= inner {
         return None;
     }
+    let left = corners as u32..(corners + left_count) as u32;
+    let right = left.end..points.len() as u32;
 
     // One allocation for everything: half a's slots, half b's, then room
     // for the seam's triangles (at most all of them). The zeroed pages are
@@ -459,7 +467,7 @@ pub(crate) fn triangulate_in_polygon_split<V: EdgeVisitor>(
                 let mut sum = visitor.start();
                 let (t, h) = (triangles_a, halfedges_a);
                 let half = triangulate_half(
-                    points, corners, &left, split, true, t, h, 0, visitor, &mut sum,
+                    points, corners, left, split, true, t, h, 0, visitor, &mut sum,
                 );
                 (half, sum)
             },
@@ -467,7 +475,7 @@ pub(crate) fn triangulate_in_polygon_split<V: EdgeVisitor>(
                 let mut sum = visitor.start();
                 let (t, h, offset) = (triangles_b, halfedges_b, slots_a as u32);
                 let half = triangulate_half(
-                    points, corners, &right, split, false, t, h, offset, visitor, &mut sum,
+                    points, corners, right, split, false, t, h, offset, visitor, &mut sum,
                 );
                 (half, sum)
             },
@@ -933,6 +941,9 @@ mod tests {
     fn check_split(name: &str, mut inner: Vec<[f64; 2]>) {
         inner.sort_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
         inner.dedup();
+        // Split at the median abscissa: the points below it come first.
+        let split = inner[inner.len() / 2][0];
+        let left = inner.iter().filter(|p| p[0] < split).count();
         let mut points = square_corners();
         points.extend(inner);
         let pool = rayon::ThreadPoolBuilder::new()
@@ -940,7 +951,7 @@ mod tests {
             .build()
             .unwrap();
         let (tri, counts) = pool
-            .install(|| triangulate_in_polygon_split(&points, 4, &Count))
+            .install(|| triangulate_in_polygon_split(&points, 4, left, split, &Count))
             .unwrap_or_else(|| panic!("{name}: the split triangulation gave up"));
         check_delaunay(&points, 4, &tri);
         // The visitor saw each inner halfedge once: three per triangle,

@@ -94,69 +94,160 @@ pub fn disk_voronoi_areas(points: &[[f64; 2]]) -> Vec<f64> {
     if n == 0 {
         return Vec::new();
     }
-    let accepted = points.iter().all(|p| {
-        p[0].is_finite()
-            && p[1].is_finite()
-            && p[0] * p[0] + p[1] * p[1] <= FAST_PATH_RADIUS * FAST_PATH_RADIUS
-    });
-    if !accepted || n >= (u32::MAX / 8) as usize {
-        return reference_disk_voronoi_areas(points);
-    }
-
-    // Spatial order, with coincident points next to each other.
-    let order = hilbert_order(points);
-    // The triangulation's vertices: the ghost ring, then one per distinct
-    // point in Hilbert order; `group_of[i]` is point i's cell.
-    let mut vertices: Vec<[f64; 2]> = Vec::with_capacity(GHOSTS + n);
-    vertices.extend(ghost_ring());
-    let mut group_of = vec![0u32; n];
-    let mut group_size: Vec<u32> = Vec::with_capacity(n);
-    for (pos, &i) in order.iter().enumerate() {
-        let p = points[i as usize];
-        if pos == 0 || points[order[pos - 1] as usize] != p {
-            vertices.push(p);
-            group_size.push(0);
-        }
-        let g = group_size.len() - 1;
-        group_of[i as usize] = g as u32;
-        group_size[g] += 1;
-    }
-    let Some(cell_areas) = cell_areas(&vertices) else {
-        return reference_disk_voronoi_areas(points);
-    };
-    group_of
-        .iter()
-        .map(|&g| cell_areas[g as usize] / group_size[g as usize] as f64)
-        .collect()
-}
-
-/// Bits per coordinate of the Hilbert key.
-const HILBERT_LEVELS: u32 = 16;
-
-/// The indices of `points` (all finite) in Hilbert-curve order over their
-/// bounding box, ties (the same curve cell) broken by the coordinates, so
-/// that coincident points are adjacent and the order does not depend on the
-/// input order except among coincident points.
-fn hilbert_order(points: &[[f64; 2]]) -> Vec<u32> {
-    let side = ((1u32 << HILBERT_LEVELS) - 1) as f64;
+    // One pass: every point finite and within the fast path's radius, and
+    // the bounding box (the frame of the Hilbert curve).
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    let mut accepted = true;
     for p in points {
+        accepted &= p[0].is_finite()
+            && p[1].is_finite()
+            && p[0] * p[0] + p[1] * p[1] <= FAST_PATH_RADIUS * FAST_PATH_RADIUS;
         for k in 0..2 {
             lo[k] = lo[k].min(p[k]);
             hi[k] = hi[k].max(p[k]);
         }
     }
-    let scale = side / (hi[0] - lo[0]).max(hi[1] - lo[1]).max(f64::MIN_POSITIVE);
-    let keyed: Vec<u64> = points
+    if !accepted || n >= (u32::MAX / 8) as usize {
+        return reference_disk_voronoi_areas(points);
+    }
+    let side = ((1u32 << HILBERT_LEVELS) - 1) as f64;
+    let frame = CurveFrame {
+        lo,
+        scale: side / (hi[0] - lo[0]).max(hi[1] - lo[1]).max(f64::MIN_POSITIVE),
+    };
+
+    // With two threads, the points left and right of a vertical line are
+    // sorted and triangulated on one thread each.
+    let split = (n >= delaunay::SPLIT_MIN_POINTS && rayon::current_num_threads() >= 2)
+        .then(|| middle_abscissa(points, lo[0], hi[0]))
+        .flatten();
+    let pieces = match split {
+        Some(x) => {
+            let (left, right) = rayon::join(
+                || Piece::sorted(points, &frame, |p| p[0] < x),
+                || Piece::sorted(points, &frame, |p| p[0] >= x),
+            );
+            vec![left, right]
+        }
+        None => vec![Piece::sorted(points, &frame, |_| true)],
+    };
+    let halves = split.map(|x| (pieces[0].unique.len(), x));
+
+    // The triangulation's vertices: the ghost ring, then each piece's
+    // distinct points in its spatial order; `group_of[i]` is point i's cell.
+    let distinct: usize = pieces.iter().map(|piece| piece.unique.len()).sum();
+    let mut vertices: Vec<[f64; 2]> = Vec::with_capacity(GHOSTS + distinct);
+    vertices.extend(ghost_ring());
+    let mut group_of = vec![0u32; n];
+    let mut group_size: Vec<u32> = Vec::with_capacity(distinct);
+    for piece in &pieces {
+        let first = group_size.len() as u32;
+        vertices.extend_from_slice(&piece.unique);
+        group_size.extend_from_slice(&piece.sizes);
+        for (&i, &g) in piece.order.iter().zip(&piece.group) {
+            group_of[i as usize] = first + g;
+        }
+    }
+    let Some(cell_areas) = cell_areas(&vertices, halves) else {
+        return reference_disk_voronoi_areas(points);
+    };
+    group_of
         .par_iter()
         .with_min_len(4096)
-        .enumerate()
-        .map(|(i, p)| {
-            let x = ((p[0] - lo[0]) * scale) as u32;
-            let y = ((p[1] - lo[1]) * scale) as u32;
-            (u64::from(hilbert_key(x, y)) << 32) | i as u64
-        })
-        .collect();
+        .map(|&g| cell_areas[g as usize] / group_size[g as usize] as f64)
+        .collect()
+}
+
+/// An abscissa with about half of `points` on either side (from a
+/// histogram over `lo..hi`, so it does not depend on their order), or
+/// `None` if one side would be empty.
+fn middle_abscissa(points: &[[f64; 2]], lo: f64, hi: f64) -> Option<f64> {
+    const BINS: usize = 4096;
+    let width = (hi - lo) / BINS as f64;
+    if width <= 0.0 {
+        return None;
+    }
+    let mut counts = vec![0usize; BINS];
+    for p in points {
+        counts[(((p[0] - lo) / width) as usize).min(BINS - 1)] += 1;
+    }
+    let mut below = 0;
+    for (bin, &count) in counts.iter().enumerate() {
+        below += count;
+        if 2 * below >= points.len() {
+            let x = lo + (bin + 1) as f64 * width;
+            return (x < hi).then_some(x);
+        }
+    }
+    None
+}
+
+/// The frame of the Hilbert curve: the bounding box's low corner and the
+/// scale to curve cells.
+struct CurveFrame {
+    lo: [f64; 2],
+    scale: f64,
+}
+
+impl CurveFrame {
+    fn key(&self, p: [f64; 2]) -> u32 {
+        let x = ((p[0] - self.lo[0]) * self.scale) as u32;
+        let y = ((p[1] - self.lo[1]) * self.scale) as u32;
+        hilbert_key(x, y)
+    }
+}
+
+/// Some of the points in spatial order, coincident ones merged.
+struct Piece {
+    /// The points' indices, in Hilbert order (ties by their coordinates).
+    order: Vec<u32>,
+    /// The distinct point (cell) of each entry of `order`.
+    group: Vec<u32>,
+    /// The distinct points, in order.
+    unique: Vec<[f64; 2]>,
+    /// How many points share each distinct point.
+    sizes: Vec<u32>,
+}
+
+impl Piece {
+    /// The points for which `keep` holds.
+    fn sorted(points: &[[f64; 2]], frame: &CurveFrame, keep: impl Fn(&[f64; 2]) -> bool) -> Piece {
+        let keyed: Vec<u64> = points
+            .iter()
+            .enumerate()
+            .filter(|(_, p)| keep(p))
+            .map(|(i, p)| (u64::from(frame.key(*p)) << 32) | i as u64)
+            .collect();
+        let order = hilbert_order(points, keyed);
+        let mut group = Vec::with_capacity(order.len());
+        let mut unique: Vec<[f64; 2]> = Vec::with_capacity(order.len());
+        let mut sizes: Vec<u32> = Vec::with_capacity(order.len());
+        for &i in &order {
+            let p = points[i as usize];
+            if unique.last() != Some(&p) {
+                unique.push(p);
+                sizes.push(0);
+            }
+            *sizes.last_mut().expect("a group was just opened") += 1;
+            group.push(unique.len() as u32 - 1);
+        }
+        Piece {
+            order,
+            group,
+            unique,
+            sizes,
+        }
+    }
+}
+
+/// Bits per coordinate of the Hilbert key.
+const HILBERT_LEVELS: u32 = 16;
+
+/// The point indices of `keyed` (Hilbert key above, index below) in
+/// Hilbert-curve order, ties (the same curve cell) broken by the
+/// coordinates, so that coincident points are adjacent and the order does
+/// not depend on the input order except among coincident points.
+fn hilbert_order(points: &[[f64; 2]], keyed: Vec<u64>) -> Vec<u32> {
     let keyed = sort_by_high_half(keyed);
     let mut order: Vec<u32> = keyed.iter().map(|&k| k as u32).collect();
     // Points in the same curve cell: order them by their coordinates.
@@ -311,10 +402,11 @@ impl delaunay::EdgeVisitor for CellSums {
 /// `None` if the triangulation gave up or a cell is not finite (never
 /// seen). The per-thread sums are added in a fixed order, so the result
 /// does not depend on scheduling.
-fn cell_areas(vertices: &[[f64; 2]]) -> Option<Vec<f64>> {
+fn cell_areas(vertices: &[[f64; 2]], halves: Option<(usize, f64)>) -> Option<Vec<f64>> {
     let (_, sums) = delaunay::triangulate_spatially_ordered(
         vertices,
         GHOSTS,
+        halves,
         &CellSums {
             vertices: vertices.len(),
         },
