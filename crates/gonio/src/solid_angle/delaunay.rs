@@ -491,14 +491,50 @@ pub(crate) fn triangulate_in_polygon_split<V: EdgeVisitor>(
         .map(|k| seam[k as usize])
         .collect();
     let gap = triangulate_in_polygon(points, corners, &order)?;
-    let key = |from: u32, to: u32| (u64::from(from) << 32) | u64::from(to);
-    let mut by_ends: Vec<(u64, u32)> = (0..gap.triangles.len() as u32)
-        .map(|e| {
-            let from = gap.triangles[e as usize];
-            (key(from, gap.triangles[next(e) as usize]), e)
-        })
-        .collect();
-    by_ends.sort_unstable();
+    // One halfedge of the seam triangulation out of each of its vertices:
+    // the halfedge between two given vertices is found by turning about
+    // the first (a few steps) rather than by sorting all of them.
+    let mut out_of = vec![NONE; points.len()];
+    for (g, &v) in gap.triangles.iter().enumerate() {
+        out_of[v as usize] = g as u32;
+    }
+    let find = |from: u32, to: u32| -> Option<u32> {
+        let start = out_of[from as usize];
+        if start == NONE {
+            return None;
+        }
+        // Counter-clockwise about `from`, then clockwise if the polygon's
+        // side stops the turn.
+        let mut g = start;
+        for _ in 0..gap.triangles.len() {
+            if gap.triangles[next(g) as usize] == to {
+                return Some(g);
+            }
+            let twin = gap.halfedges[prev(g) as usize];
+            if twin == NONE {
+                break;
+            }
+            g = twin;
+            if g == start {
+                return None;
+            }
+        }
+        let mut g = start;
+        for _ in 0..gap.triangles.len() {
+            let twin = gap.halfedges[g as usize];
+            if twin == NONE {
+                return None;
+            }
+            g = next(twin);
+            if gap.triangles[next(g) as usize] == to {
+                return Some(g);
+            }
+            if g == start {
+                return None;
+            }
+        }
+        None
+    };
 
     // Pair each boundary halfedge with its twin in the seam triangulation
     // (`partner`, merged numbering), checking the in-circle test.
@@ -509,8 +545,7 @@ pub(crate) fn triangulate_in_polygon_split<V: EdgeVisitor>(
         let u = triangles[e as usize];
         let v = triangles[next(e) as usize];
         let w = triangles[prev(e) as usize];
-        let at = by_ends.binary_search_by_key(&key(v, u), |&(k, _)| k).ok()?;
-        let g = by_ends[at].1;
+        let g = find(v, u)?;
         if partner[g as usize] != NONE {
             return None;
         }
