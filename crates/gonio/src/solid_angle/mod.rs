@@ -135,8 +135,10 @@ pub fn detect_layout(samples: &[Sample]) -> [Option<Layout>; 2] {
 
 fn compute(samples: &[Sample], path: Path) -> Vec<f64> {
     let mut weights = vec![0.0; samples.len()];
-    for hemisphere in [Hemisphere::Front, Hemisphere::Back] {
-        let (indices, directions) = hemisphere_directions(samples, hemisphere);
+    let [front, back] = both_hemispheres(samples);
+    for (hemisphere, (indices, directions)) in
+        [(Hemisphere::Front, front), (Hemisphere::Back, back)]
+    {
         if directions.is_empty() {
             continue;
         }
@@ -152,11 +154,28 @@ fn compute(samples: &[Sample], path: Path) -> Vec<f64> {
     weights
 }
 
+/// Sample indices and their `(θ, φ)` in degrees.
+type Directions = (Vec<usize>, Vec<(f64, f64)>);
+
+/// The indices and `(θ, φ)` of the valid samples in each hemisphere, front
+/// then back, in one pass.
+fn both_hemispheres(samples: &[Sample]) -> [Directions; 2] {
+    let mut split: [Directions; 2] = Default::default();
+    for (i, s) in samples.iter().enumerate() {
+        let valid = s.theta_deg.is_finite()
+            && (0.0..=180.0).contains(&s.theta_deg)
+            && s.phi_deg.is_finite();
+        if valid {
+            let side = &mut split[usize::from(s.hemisphere() == Hemisphere::Back)];
+            side.0.push(i);
+            side.1.push((s.theta_deg, s.phi_deg));
+        }
+    }
+    split
+}
+
 /// The indices and `(θ, φ)` of the valid samples in `hemisphere`.
-fn hemisphere_directions(
-    samples: &[Sample],
-    hemisphere: Hemisphere,
-) -> (Vec<usize>, Vec<(f64, f64)>) {
+fn hemisphere_directions(samples: &[Sample], hemisphere: Hemisphere) -> Directions {
     let mut indices = Vec::new();
     let mut directions = Vec::new();
     for (i, s) in samples.iter().enumerate() {
