@@ -240,3 +240,34 @@ fn points_beyond_the_fast_path_use_the_reference() {
     let total: f64 = disk_voronoi_areas(&points).iter().sum();
     assert!((total - 2.0 * PI).abs() < 1e-9);
 }
+
+#[test]
+fn one_thread_and_two_give_the_same_cells() {
+    // Two threads split the points at a median abscissa, sort and
+    // triangulate each half on its own thread and re-triangulate the seam;
+    // one thread triangulates everything at once. The Voronoi diagram is
+    // the same, so the cells agree to rounding, on both real scans.
+    for (name, m) in [("golden_paper", golden()), ("layer_020_030", layer())] {
+        let points = projected(m, Hemisphere::Front);
+        let with = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| disk_voronoi_areas(&points))
+        };
+        let (one, two) = (with(1), with(2));
+        assert_eq!(one.len(), two.len());
+        // Not bit for bit: otherwise the split path gave up and fell back to
+        // the single triangulation, and this test compares nothing.
+        assert_ne!(one, two, "{name}: two threads did not take the split path");
+        for (i, (a, b)) in one.iter().zip(&two).enumerate() {
+            assert!(
+                (a - b).abs() <= TOLERANCE * b.abs() || (a - b).abs() <= ABSOLUTE_TOLERANCE_SR,
+                "{name}: point {i}: {a} with one thread, {b} with two"
+            );
+        }
+        let total: f64 = two.iter().sum();
+        assert!((total - TAU).abs() < 1e-9, "{name}: {total}");
+    }
+}
