@@ -10,9 +10,17 @@
 //! Delaunay property. Because every point is inside the polygon, the convex
 //! hull never changes and no "outside" case exists.
 //!
-//! With two threads the points left and right of their median x are
-//! triangulated in parallel and the seam between them is triangulated
-//! again, with a checked certificate ([`triangulate_in_polygon_split`]).
+//! The walk tests each edge once (not the one it came in by) and the
+//! triangles are held during insertion as one 32-byte record each (three
+//! vertices and three twins), so a walk step or a flip reads one cache
+//! line per triangle; the result is converted to the flat layout below.
+//!
+//! With two threads the caller's two halves (points left and right of a
+//! vertical line, each in spatial order) are triangulated in parallel and
+//! the seam between them is triangulated again, with a checked certificate
+//! ([`triangulate_in_polygon_split`]). Every triangle's halfedges are
+//! handed to an [`EdgeVisitor`] with the circumcentres on both sides, on
+//! the thread that made them: the Voronoi cells are summed there.
 //!
 //! Why not `delaunator`: the real pgII scans are long paths of near-collinear
 //! points 0.04° apart. delaunator's sweep adds them in order of distance from
@@ -411,8 +419,9 @@ pub(crate) fn circumcentre(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> [f64; 2] {
 /// The Delaunay triangulation of [`triangulate_spatially_ordered`], built
 /// on two threads:
 ///
-/// 1. The points are split by the vertical line x = s through (about) their
-///    median; each half is triangulated with the polygon's corners, in
+/// 1. The inner points come as two halves: the first `left_count` have
+///    x < `split`, the others x ≥ `split`, each half in spatial order
+///    (checked). Each half is triangulated with the polygon's corners, in
 ///    parallel, straight into its share of the merged slots.
 /// 2. A triangle of one half whose vertices and circumcircle lie strictly
 ///    on its side is *kept*: no point of the other half can be in its
@@ -432,6 +441,10 @@ pub(crate) fn circumcentre(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> [f64; 2] {
 /// Delaunay by construction, the result is then locally Delaunay
 /// everywhere, hence a Delaunay triangulation of all the points. The
 /// halves' triangles not kept stay as unused slots ([`NONE`] vertices).
+/// The visitor gets the halfedges of the kept triangles from the halves'
+/// threads (accumulators 0 and 1) and those of the seam's triangles from
+/// this one (into accumulator 0); its sums are only returned with a
+/// triangulation that passed the checks.
 pub(crate) fn triangulate_in_polygon_split<V: EdgeVisitor>(
     points: &[[f64; 2]],
     corners: usize,

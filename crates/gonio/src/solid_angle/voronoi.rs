@@ -26,16 +26,34 @@
 //! triangulation.
 //!
 //! The triangulation is our own incremental Delaunay in a biased randomised
-//! Hilbert order with exact predicates (module `delaunay`), about three
-//! times faster in CPU time than `delaunator` on the real scans' long
-//! near-collinear paths, and run on two threads (the halves either side of
-//! the median x, then their seam); the cells are then summed edge by edge
-//! in parallel. The Voronoi diagram does not depend on the triangulation
-//! method, so both give the same cells up to
-//! rounding; [`reference_disk_voronoi_areas`] keeps the former
-//! delaunator-based computation as the reference the tests compare with,
-//! and as the fallback for points the fast path does not accept (outside
-//! radius 2√2 or not finite).
+//! Hilbert order with exact predicates behind a floating-point filter
+//! (module `delaunay`), several times faster than `delaunator` on the real
+//! scans' long near-collinear paths. With two threads and enough points
+//! ([`disk_voronoi_areas`]):
+//!
+//! 1. one pass checks the points and takes their bounding box; a histogram
+//!    of x gives a split line with about half the points on either side
+//!    (from the histogram, so independent of the input order);
+//! 2. each half, on its own thread, computes its points' Hilbert keys
+//!    (four curve levels per table look-up), sorts them (a stable radix
+//!    sort, ties by the coordinates) and merges coincident points, then
+//!    triangulates them with the ghost ring;
+//! 3. each half keeps the triangles whose circumcircle lies on its side of
+//!    the line and sums their share of the cells as it classifies them:
+//!    per Delaunay halfedge u → v, the origin-fan term of its dual Voronoi
+//!    edge (the circumcentres left and right of it, clipped to the disk)
+//!    added to u's cell. No pass over stored circumcentres, no pointer
+//!    chasing around vertices;
+//! 4. the seam between the halves is triangulated again and checked, and
+//!    its halfedges add their terms the same way (module `delaunay`);
+//! 5. the per-thread sums are added in a fixed order.
+//!
+//! With one thread the same steps run on all the points at once. The
+//! Voronoi diagram does not depend on the triangulation method, so both,
+//! and the delaunator-based [`reference_disk_voronoi_areas`], give the same
+//! cells up to rounding; the reference is what the tests compare with, and
+//! the fallback for points the fast path does not accept (outside radius
+//! 2√2 or not finite).
 
 use std::collections::HashMap;
 
