@@ -395,9 +395,7 @@ fn candidates_full_costs(
         .iter()
         .map(|u| {
             *evaluations += 1;
-            problem
-                .residual_vector(u)
-                .map_or(f64::INFINITY, |r| 0.5 * r.norm_squared())
+            problem.cost(u).unwrap_or(f64::INFINITY)
         })
         .collect()
 }

@@ -248,17 +248,9 @@ impl<'a> Problem<'a> {
         }
     }
 
-    /// One pass over the data: with `COMPRESS`, values and gradients
-    /// reduced to the triangle of `[J | r]`; without, the residuals alone.
-    /// Also the unweighted RMS of `(m − y)/sqrt(y² + floor²)`, reported
-    /// as `rms_rel`. Large problems are split into fixed chunks evaluated
-    /// in parallel; the chunking and the order of the reductions do not
-    /// depend on the thread count, so results are deterministic.
-    fn pass<const COMPRESS: bool>(&self, u: &DVector<f64>) -> Option<Pass> {
+    /// The pass kernel at `u` and the fixed chunks of the samples.
+    fn kernel(&self, u: &DVector<f64>) -> Option<(Kernel<'_>, Vec<Chunk>)> {
         let (_, dp, material, scale) = self.physical(u)?;
-        let n = self.map.len();
-        let width = n + 1;
-        let m = self.n_residuals();
         let mut chunks: Vec<Chunk> = Vec::new();
         for (b, block) in self.blocks.iter().enumerate() {
             let mut start = 0;
@@ -283,6 +275,37 @@ impl<'a> Problem<'a> {
             channels: self.channels,
             blocks: self.blocks,
         };
+        Some((kernel, chunks))
+    }
+
+    /// The cost ½‖r‖² at `u` (`None` when a residual is not finite), from
+    /// one pass that keeps neither the residuals nor the relative errors:
+    /// what choosing among candidates needs. Summed per chunk, then over
+    /// the chunks in order, so the result does not depend on the threads.
+    pub(crate) fn cost(&self, u: &DVector<f64>) -> Option<f64> {
+        let (kernel, chunks) = self.kernel(u)?;
+        let squares = |chunk: &Chunk| kernel.squares(*chunk);
+        let parts: Vec<f64> = if self.n_residuals() >= PARALLEL_ROWS {
+            chunks.par_iter().map(squares).collect()
+        } else {
+            chunks.iter().map(squares).collect()
+        };
+        self.evaluations.set(self.evaluations.get() + 1);
+        let sum: f64 = parts.iter().sum();
+        sum.is_finite().then_some(0.5 * sum)
+    }
+
+    /// One pass over the data: with `COMPRESS`, values and gradients
+    /// reduced to the triangle of `[J | r]`; without, the residuals alone.
+    /// Also the unweighted RMS of `(m − y)/sqrt(y² + floor²)`, reported
+    /// as `rms_rel`. Large problems are split into fixed chunks evaluated
+    /// in parallel; the chunking and the order of the reductions do not
+    /// depend on the thread count, so results are deterministic.
+    fn pass<const COMPRESS: bool>(&self, u: &DVector<f64>) -> Option<Pass> {
+        let (kernel, chunks) = self.kernel(u)?;
+        let n = self.map.len();
+        let width = n + 1;
+        let m = self.n_residuals();
         let report = self.report;
         let run_chunk = |chunk: &Chunk| -> ChunkResult {
             if !COMPRESS {
@@ -407,6 +430,39 @@ impl Kernel<'_> {
             data,
             sum_rel,
         }
+    }
+
+    /// The sum of the squared residuals of one chunk (not finite when a
+    /// residual is not).
+    fn squares(&self, (b, start, end): Chunk) -> f64 {
+        let block = &self.blocks[b];
+        let channels = self.channels;
+        let mut sum = 0.0;
+        let mut add = |i: usize, f: [f64; 3]| {
+            let s = &block.samples[i];
+            for ch in 0..channels {
+                let row = i * channels + ch;
+                let (res, _, _) =
+                    self.residual(f[ch], s.value[ch], block.factors[row], block.log_value(row));
+                sum += res * res;
+            }
+        };
+        if block.pairs.is_some() {
+            let mut scratch = GeometryBatch::new();
+            for i in start..end {
+                add(i, self.average(block, i, &mut scratch));
+            }
+        } else {
+            let mut run = Run::new();
+            for first in (start..end).step_by(RUN) {
+                let last = (first + RUN).min(end);
+                run.evaluate::<false>(self, block, first..last);
+                for i in first..last {
+                    add(i, run.value(i - first));
+                }
+            }
+        }
+        sum
     }
 
     /// The upper triangle of `[J | r]ᵀ[J | r]` of one chunk (row-major,
