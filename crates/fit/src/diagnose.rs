@@ -113,7 +113,7 @@ pub(crate) fn measured_integrals(
     bsdf: &Bsdf,
     scale: f64,
 ) -> Measured {
-    measured_sums(prepared, &fitted_model(prepared, data, bsdf), scale)
+    measured_sums(prepared, data, &fitted_model(prepared, data, bsdf), scale)
 }
 
 /// The model's value (in luminance) at every fitted sample of `prepared`,
@@ -139,13 +139,19 @@ fn fitted_model(prepared: &PreparedMeasurement, data: &IncidenceData, bsdf: &Bsd
 }
 
 /// [`measured_integrals`] with the model's values `model` from
-/// [`fitted_model`].
-fn measured_sums(prepared: &PreparedMeasurement, model: &[f64], scale: f64) -> Measured {
+/// [`fitted_model`]. |cos θ| comes from the fitter's directions `data`
+/// (their z is the same `cos θ`), not from the angles again.
+fn measured_sums(
+    prepared: &PreparedMeasurement,
+    data: &IncidenceData,
+    model: &[f64],
+    scale: f64,
+) -> Measured {
     let channels = prepared.channels();
     let mut sums = [[0.0; 2]; 2];
     let mut seen = [false; 2];
-    for ((_, s), &f) in prepared.fitted().zip(model) {
-        let weight = s.solid_angle_sr.unwrap_or(0.0) * s.abs_cos_theta();
+    for (((_, s), fitted), &f) in prepared.fitted().zip(&data.samples).zip(model) {
+        let weight = s.solid_angle_sr.unwrap_or(0.0) * fitted.view.z.abs();
         let side = usize::from(s.hemisphere() == Hemisphere::Back);
         sums[side][0] += weight * luminance(s.values, channels);
         sums[side][1] += weight * scale * f;
@@ -183,7 +189,7 @@ pub(crate) fn diagnose(
         || model_albedo(prepared, &bsdf),
         || fitted_model(prepared, data, &bsdf),
     );
-    let measured = measured_sums(prepared, &model, scale);
+    let measured = measured_sums(prepared, data, &model, scale);
     // Data's reflectance: measured part ÷ scale, plus the model's rest.
     let complete = |part: Option<(f64, f64)>, model_total: f64| {
         part.map(|(data, model)| model_total + (data - model) / scale)
