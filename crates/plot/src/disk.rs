@@ -40,7 +40,9 @@ pub fn project(v: DVec3, hemisphere: Hemisphere) -> (f64, f64) {
         Hemisphere::Front => v.z,
         Hemisphere::Back => -v.z,
     };
-    let s = v.x.hypot(v.y);
+    // Not `hypot` (a libm call): the disk's radii are far from its
+    // overflow and underflow.
+    let s = (v.x * v.x + v.y * v.y).sqrt();
     let r = (2.0 * (1.0 - c)).max(0.0).sqrt();
     if s < 1e-12 {
         (0.0, 0.0)
@@ -224,6 +226,32 @@ impl Buckets {
     }
 }
 
+/// A pixel's nearest point so far while [`Coverage::new`] propagates
+/// points over the grid. The point's coordinates are kept with it, in
+/// single precision (enough to compare candidates; the owners are
+/// measured again in double), so that neighbours offer theirs without a
+/// look-up.
+#[derive(Debug, Clone, Copy)]
+struct Seed {
+    /// Position of the point in bucket order (MAX: none yet).
+    at: u32,
+    /// Squared distance to the pixel's centre; negative when final (the
+    /// exact nearest).
+    d2: f32,
+    /// The point's coordinates.
+    x: f32,
+    y: f32,
+}
+
+impl Seed {
+    const NONE: Seed = Seed {
+        at: u32::MAX,
+        d2: f32::INFINITY,
+        x: 0.0,
+        y: 0.0,
+    };
+}
+
 /// Pixel value of [`Coverage::owner`] for pixels no sample reaches.
 pub const NONE: u32 = u32::MAX;
 
@@ -305,14 +333,12 @@ impl Coverage {
                 (lo, width - lo)
             })
             .collect();
-        // Each pixel's nearest point so far (MAX: none), named by its
-        // position in bucket order (neighbouring pixels' points are then
-        // near each other in memory), and its squared distance. First the
-        // exact nearest among the points of the 3 × 3 pixels around it:
-        // final when nearer than 1.5 pixels (every other point is
-        // farther), which is every pixel of a dense region.
+        // Each pixel's nearest point so far ([`Seed`]). First the exact
+        // nearest among the points of the 3 × 3 pixels around it: final
+        // when nearer than 1.5 pixels (every other point is farther), which
+        // is every pixel of a dense region.
         let exact2 = (1.5 * pixel * (1.0 - 1e-9)).powi(2);
-        let mut nearest = vec![(u32::MAX, f64::INFINITY); width * width];
+        let mut nearest = vec![Seed::NONE; width * width];
         nearest
             .par_chunks_mut(width)
             .enumerate()
@@ -320,8 +346,14 @@ impl Coverage {
                 let (lo, hi) = spans[j];
                 for (i, slot) in row.iter_mut().enumerate().take(hi).skip(lo) {
                     let (x, y) = centre(i, j);
-                    if let Some(found) = buckets.nearest_around(i, j, x, y) {
-                        *slot = found;
+                    if let Some((at, d2)) = buckets.nearest_around(i, j, x, y) {
+                        let (px, py) = buckets.sorted[at as usize];
+                        *slot = Seed {
+                            at,
+                            d2: if d2 <= exact2 { -1.0 } else { d2 as f32 },
+                            x: px as f32,
+                            y: py as f32,
+                        };
                     }
                 }
             });
@@ -330,28 +362,32 @@ impl Coverage {
         // row both ways): an approximate nearest-point transform. Its
         // point is the true nearest at nearly every pixel, and else one
         // a hair farther (see the module docs).
-        let offer = |nearest: &mut [(u32, f64)], at: usize, from: usize, x: f64, y: f64| {
-            let k = nearest[from].0;
+        let offer = |nearest: &mut [Seed], at: usize, from: usize, x: f32, y: f32| {
+            let candidate = nearest[from];
             let slot = &mut nearest[at];
-            if k == u32::MAX || k == slot.0 {
+            if candidate.at == u32::MAX || candidate.at == slot.at {
                 return;
             }
-            let (px, py) = buckets.sorted[k as usize];
-            let d2 = (px - x) * (px - x) + (py - y) * (py - y);
-            if d2 < slot.1 || (d2 == slot.1 && (slot.0 == u32::MAX || buckets.before(k, slot.0))) {
-                *slot = (k, d2);
+            let d2 = (candidate.x - x) * (candidate.x - x) + (candidate.y - y) * (candidate.y - y);
+            if d2 < slot.d2
+                || (d2 == slot.d2 && (slot.at == u32::MAX || buckets.before(candidate.at, slot.at)))
+            {
+                *slot = Seed { d2, ..candidate };
             }
         };
         // One row of a sweep: from the row `towards` (above or below, if
-        // any), then along the row in both directions.
-        let sweep_row = |nearest: &mut [(u32, f64)], j: usize, towards: Option<usize>| {
+        // any), then along the row in both directions. Final pixels
+        // (negative distance) are only sources.
+        let sweep_row = |nearest: &mut [Seed], j: usize, towards: Option<usize>| {
             let (lo, hi) = spans[j];
+            let y = (RADIUS - (j as f64 + 0.5) * pixel) as f32;
+            let x_of = |i: usize| (-RADIUS + (i as f64 + 0.5) * pixel) as f32;
             for i in lo..hi {
                 let at = j * width + i;
-                if nearest[at].1 <= exact2 {
+                if nearest[at].d2 < 0.0 {
                     continue;
                 }
-                let (x, y) = centre(i, j);
+                let x = x_of(i);
                 if i > lo {
                     offer(nearest, at, at - 1, x, y);
                 }
@@ -368,9 +404,8 @@ impl Coverage {
             }
             for i in (lo..hi.saturating_sub(1)).rev() {
                 let at = j * width + i;
-                if nearest[at].1 > exact2 {
-                    let (x, y) = centre(i, j);
-                    offer(nearest, at, at + 1, x, y);
+                if nearest[at].d2 >= 0.0 {
+                    offer(nearest, at, at + 1, x_of(i), y);
                 }
             }
         };
@@ -390,13 +425,15 @@ impl Coverage {
             .enumerate()
             .for_each(|(j, (row, found))| {
                 let (lo, hi) = spans[j];
-                for (i, (cell, &(mut at, mut d2))) in row.iter_mut().zip(found).enumerate() {
-                    if at == u32::MAX || i < lo || i >= hi {
+                for (i, (cell, seed)) in row.iter_mut().zip(found).enumerate() {
+                    if seed.at == u32::MAX || i < lo || i >= hi {
                         continue;
                     }
-                    if d2 > exact2 {
-                        let (x, y) = centre(i, j);
-                        let (px, py) = buckets.sorted[at as usize];
+                    let (x, y) = centre(i, j);
+                    let mut at = seed.at;
+                    let (px, py) = buckets.sorted[at as usize];
+                    let mut d2 = (px - x) * (px - x) + (py - y) * (py - y);
+                    if seed.d2 >= 0.0 {
                         let bi = floor((px + RADIUS) / pixel).clamp(0, last) as usize;
                         let bj = floor((RADIUS - py) / pixel).clamp(0, last) as usize;
                         if let Some((a, d)) = buckets.nearest_around(bi, bj, x, y)

@@ -123,12 +123,10 @@ impl Incidence {
             Hemisphere::Back => 1,
         };
         self.coverage[slot].get_or_init(|| {
-            disk_grid(
-                hemisphere,
-                self.samples
-                    .iter()
-                    .map(|s| (s.theta, s.dir, s.used(), s.data)),
-            )
+            disk_grid(hemisphere, self.samples.len(), |k| {
+                let s = &self.samples[k];
+                (s.theta, s.dir, s.used(), s.data)
+            })
         })
     }
 
@@ -206,21 +204,26 @@ impl Incidence {
     }
 }
 
-/// The nearest-sample grid of one hemisphere over samples given as
-/// `(θ_out in degrees, direction, fitted, data)`: every sample of that
-/// hemisphere with a finite direction, except fitted ones without data.
-/// Owners are positions in the sequence.
+/// The nearest-sample grid of one hemisphere over `n` samples, sample
+/// `k` given by `sample(k)` as `(θ_out in degrees, direction, fitted,
+/// data)`: every sample of that hemisphere with a finite direction, except
+/// fitted ones without data. Owners are sample indices. The samples are
+/// picked and projected in parallel.
 fn disk_grid(
     hemisphere: Hemisphere,
-    samples: impl Iterator<Item = (f64, DVec3, bool, f64)>,
+    n: usize,
+    sample: impl Fn(usize) -> (f64, DVec3, bool, f64) + Sync,
 ) -> Coverage {
-    let (ids, points): (Vec<u32>, Vec<(f64, f64)>) = samples
-        .enumerate()
-        .filter(|(_, (theta, dir, _, _))| {
-            Hemisphere::of_theta(*theta) == hemisphere && dir.is_finite()
+    let (ids, points): (Vec<u32>, Vec<(f64, f64)>) = (0..n)
+        .into_par_iter()
+        .with_min_len(4096)
+        .filter_map(|k| {
+            let (theta, dir, used, data) = sample(k);
+            let keep = Hemisphere::of_theta(theta) == hemisphere
+                && dir.is_finite()
+                && (!used || data.is_finite());
+            keep.then(|| (k as u32, disk::project(dir, hemisphere)))
         })
-        .filter(|(_, (_, _, used, data))| !used || data.is_finite())
-        .map(|(k, (_, dir, _, _))| (k as u32, disk::project(dir, hemisphere)))
         .unzip();
     Coverage::new(
         &points,
@@ -402,20 +405,16 @@ fn build(
     // the model: made at the same time as the model, they are ready when
     // the charts start.
     let grid_of = |hemisphere: Hemisphere| {
-        disk_grid(
-            hemisphere,
-            m.samples
-                .iter()
-                .zip(removed_by)
-                .zip(&dirs)
-                .map(|((s, removed), dir)| {
-                    let mut data = 0.0;
-                    for y in s.values.iter().take(channels) {
-                        data += y;
-                    }
-                    (s.theta_deg, *dir, removed.is_none(), data / channels as f64)
-                }),
-        )
+        disk_grid(hemisphere, m.samples.len(), |k| {
+            let s = &m.samples[k];
+            let data: f64 = s.values.iter().take(channels).sum();
+            (
+                s.theta_deg,
+                dirs[k],
+                removed_by[k].is_none(),
+                data / channels as f64,
+            )
+        })
     };
     let (blocks, (front, back)) = rayon::join(samples_with_model, || {
         rayon::join(|| grid_of(Hemisphere::Front), || grid_of(Hemisphere::Back))

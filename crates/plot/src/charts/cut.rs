@@ -123,6 +123,7 @@ impl<'a> CutData<'a> {
     /// The cut of `inc` with samples as indices into `inc.samples`.
     fn make(inc: &Incidence, tolerance: Option<f64>) -> CutCache {
         let plane = Plane::of(inc);
+        let near_limit = (TOLERANCES[TOLERANCES.len() - 1] + 0.01).to_radians().sin();
         // Made once per incidence: the cut's SVG and PNG and the chart of
         // all cuts each need them.
         let near: Vec<(f64, f64, usize, &PlotSample)> = inc
@@ -131,7 +132,11 @@ impl<'a> CutData<'a> {
                     .par_iter()
                     .enumerate()
                     .with_min_len(4096)
-                    .filter(|(_, s)| s.dir.is_finite())
+                    // Most samples are far from the plane: a dot product
+                    // (with a margin) rules them out before any asin/atan2.
+                    .filter(|(_, s)| {
+                        s.dir.is_finite() && s.dir.dot(plane.normal).abs() <= near_limit
+                    })
                     .map(|(k, s)| (plane.offset(s.dir), plane.x_of(s.dir), k))
                     .filter(|(o, _, _)| *o <= TOLERANCES[TOLERANCES.len() - 1])
                     .collect()
