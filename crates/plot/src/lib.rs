@@ -145,6 +145,11 @@ enum Job<'a> {
 }
 
 impl Job<'_> {
+    /// The chart reads the incidences' nearest-sample grids.
+    fn needs_coverage(&self) -> bool {
+        matches!(self, Job::Map(_) | Job::Rho(_))
+    }
+
     fn render(&self, dir: &Path) -> Result<Vec<(PathBuf, Vec<u8>)>, PlotError> {
         match self {
             Job::Map(c) => render_files(c, dir),
@@ -165,11 +170,14 @@ const WRITERS: usize = 4;
 /// Renders every job and writes its files, then `last` (the report) once
 /// every job rendered; returns the paths in `jobs` order, then `last`'s.
 /// The files are written by threads of their own, so that rendering never
-/// waits for the disk (each write syncs).
+/// waits for the disk (each write syncs). `grids` makes the nearest-sample
+/// grids, at the same time as the charts that do not need them; the maps
+/// and the reflectance chart render after it.
 fn render_and_write(
     jobs: &[Job],
     dir: &Path,
     last: (PathBuf, Vec<u8>),
+    grids: impl Fn() + Sync,
 ) -> Result<Vec<PathBuf>, PlotError> {
     let (send, receive) = std::sync::mpsc::channel::<(PathBuf, Vec<u8>)>();
     let receive = std::sync::Mutex::new(receive);
@@ -204,7 +212,20 @@ fn render_and_write(
             }
             Ok(paths)
         };
-        let rendered: Result<Vec<Vec<PathBuf>>, PlotError> = jobs.par_iter().map(render).collect();
+        // First the charts without grids, beside the grids, then the rest
+        // (each in `jobs` order).
+        let pass = |with_grids: bool| -> Vec<(usize, Result<Vec<PathBuf>, PlotError>)> {
+            jobs.par_iter()
+                .enumerate()
+                .filter(|(_, job)| job.needs_coverage() == with_grids)
+                .map(|(k, job)| (k, render(job)))
+                .collect()
+        };
+        let (mut done, ()) = rayon::join(|| pass(false), &grids);
+        done.extend(pass(true));
+        done.sort_by_key(|(k, _)| *k);
+        let rendered: Result<Vec<Vec<PathBuf>>, PlotError> =
+            done.into_iter().map(|(_, paths)| paths).collect();
         let last_path = last.0.clone();
         if rendered.is_ok() {
             let _ = send.send(last);
@@ -442,7 +463,25 @@ fn plot(
     });
     // The report is written with the plots' files, once they all rendered.
     let report_path = dir.join("report.html");
-    let files = render_and_write(&jobs, &plots, (report_path.clone(), html.into_bytes()))?;
+    let grids = || {
+        incs.par_iter().for_each(|inc| {
+            // Every grid a chart asks for (a map without fitted samples
+            // draws an empty front disk).
+            let mut hemispheres = inc.hemispheres();
+            if hemispheres.is_empty() {
+                hemispheres.push(brtf_gonio::Hemisphere::Front);
+            }
+            for hemisphere in hemispheres {
+                inc.coverage(hemisphere);
+            }
+        })
+    };
+    let files = render_and_write(
+        &jobs,
+        &plots,
+        (report_path.clone(), html.into_bytes()),
+        grids,
+    )?;
     remove_stale(&plots, &files);
     Ok(Written {
         files,

@@ -88,8 +88,9 @@ pub struct Incidence {
     pub channels: usize,
     /// Things the reader should know about this incidence's plots.
     pub warnings: Vec<String>,
-    /// Nearest-sample grids of the front and back disks, made with the
-    /// samples (at the same time as the model).
+    /// Nearest-sample grids of the front and back disks, made on first
+    /// use (`write_plots` makes them while the charts that do not need
+    /// them render).
     coverage: [OnceLock<Coverage>; 2],
     /// The samples near the plane of incidence, for the cuts.
     near_plane: OnceLock<Vec<(f64, f64, usize)>>,
@@ -114,8 +115,8 @@ pub struct CutCache {
 
 impl Incidence {
     /// Every pixel of the `hemisphere`'s equal-area disk and the sample
-    /// that owns it (fitted or not; an index into `samples`), made when
-    /// the incidence is built. The maps draw it, the hemispherical
+    /// that owns it (fitted or not; an index into `samples`), made on
+    /// first use. The maps draw it, the hemispherical
     /// integrals sum over it.
     pub fn coverage(&self, hemisphere: Hemisphere) -> &Coverage {
         let slot = match hemisphere {
@@ -401,24 +402,7 @@ fn build(
             })
             .collect()
     };
-    // The nearest-sample grids need only the directions and the data, not
-    // the model: made at the same time as the model, they are ready when
-    // the charts start.
-    let grid_of = |hemisphere: Hemisphere| {
-        disk_grid(hemisphere, m.samples.len(), |k| {
-            let s = &m.samples[k];
-            let data: f64 = s.values.iter().take(channels).sum();
-            (
-                s.theta_deg,
-                dirs[k],
-                removed_by[k].is_none(),
-                data / channels as f64,
-            )
-        })
-    };
-    let (blocks, (front, back)) = rayon::join(samples_with_model, || {
-        rayon::join(|| grid_of(Hemisphere::Front), || grid_of(Hemisphere::Back))
-    });
+    let blocks = samples_with_model();
     // Whole blocks copied into one vector; the errors summed in sample order.
     let mut samples: Vec<PlotSample> = Vec::with_capacity(m.samples.len());
     let mut sum_rel = 0.0;
@@ -467,7 +451,7 @@ fn build(
         scale: report.scale,
         channels,
         warnings,
-        coverage: [OnceLock::from(front), OnceLock::from(back)],
+        coverage: [OnceLock::new(), OnceLock::new()],
         near_plane: OnceLock::new(),
         cut: OnceLock::new(),
     };
