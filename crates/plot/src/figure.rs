@@ -240,10 +240,12 @@ pub fn encode_png(w: u32, h: u32, colour: png::ColorType, data: &[u8]) -> Result
     let mut encoder = png::Encoder::new(&mut out, w, h);
     encoder.set_color(colour);
     encoder.set_depth(png::BitDepth::Eight);
-    // Fast: fdeflate with the adaptive filter. (Fastest, the Up filter
-    // alone, saves about 3 ms over all plots of a 127k-point scan but
-    // makes the charts' PNGs up to twice as large.)
+    // Fast: fdeflate. The Paeth filter on every row: on the charts of a
+    // 127k-point scan, within 6% of the adaptive filter's size (which
+    // tries all five per row) in 55-75% of its time; Up or Sub alone are
+    // a little faster but make PNGs up to twice as large.
     encoder.set_compression(png::Compression::Fast);
+    encoder.set_filter(png::Filter::Paeth);
     let mut writer = encoder.write_header().msg()?;
     writer.write_image_data(data).msg()?;
     writer.finish().msg()?;

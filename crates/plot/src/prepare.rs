@@ -325,90 +325,93 @@ fn build(
         .map(|s| s.direction())
         .collect();
     // Each block: its samples, and the errors of its fitted ones in order.
-    let samples_with_model = || -> Vec<(Vec<PlotSample>, Vec<[f64; 3]>)> {
-        m.samples
-            .par_chunks(BLOCK)
-            .zip(removed_by.par_chunks(BLOCK))
-            .zip(dirs.par_chunks(BLOCK))
-            .enumerate()
-            .map(|(b, ((block, removed), dirs))| {
-                // Patch-averaged (Klems) data are compared with the averaged
-                // model ([`PreparedMeasurement::model_value`]); else the model
-                // is the BSDF at each direction, evaluated for the whole block
-                // at once (brtf-model's batch kernel, equal to `Bsdf::eval` to
-                // about 1e-15).
-                let mut values = brtf_model::RgbBatch::default();
-                match prepared.patch_pairs {
-                    Some(_) => {
-                        values.resize(0);
-                        for k in 0..block.len() {
-                            let f = prepared.model_value(&bsdf, b * BLOCK + k);
-                            values.r.push(f[0]);
-                            values.g.push(f[1]);
-                            values.b.push(f[2]);
-                        }
-                    }
-                    None => {
-                        let n = block.len();
-                        let light = brtf_model::Directions {
-                            x: vec![incident.x; n],
-                            y: vec![incident.y; n],
-                            z: vec![incident.z; n],
-                        };
-                        bsdf.eval_batch(
-                            &light,
-                            &brtf_model::Directions::from_vectors(dirs),
-                            &mut values,
-                        );
+    // Written in place, block by block (no second copy of every sample).
+    let unset = PlotSample {
+        theta: f64::NAN,
+        phi: f64::NAN,
+        dir: DVec3::ZERO,
+        data: f64::NAN,
+        model: f64::NAN,
+        removed_by: None,
+        log_ratio: f64::NAN,
+    };
+    let mut samples: Vec<PlotSample> = vec![unset; m.samples.len()];
+    let rels_of_blocks: Vec<Vec<[f64; 3]>> = samples
+        .par_chunks_mut(BLOCK)
+        .zip(m.samples.par_chunks(BLOCK))
+        .zip(removed_by.par_chunks(BLOCK))
+        .zip(dirs.par_chunks(BLOCK))
+        .enumerate()
+        .map(|(b, (((out, block), removed), dirs))| {
+            // Patch-averaged (Klems) data are compared with the averaged
+            // model ([`PreparedMeasurement::model_value`]); else the model
+            // is the BSDF at each direction, evaluated for the whole block
+            // at once (brtf-model's batch kernel, equal to `Bsdf::eval` to
+            // about 1e-15).
+            let mut values = brtf_model::RgbBatch::default();
+            match prepared.patch_pairs {
+                Some(_) => {
+                    values.resize(0);
+                    for k in 0..block.len() {
+                        let f = prepared.model_value(&bsdf, b * BLOCK + k);
+                        values.r.push(f[0]);
+                        values.g.push(f[1]);
+                        values.b.push(f[2]);
                     }
                 }
-                let mut rels = Vec::new();
-                let samples = block
-                    .iter()
-                    .zip(removed)
-                    .zip(dirs)
-                    .enumerate()
-                    .map(|(k, ((s, removed), dir))| {
-                        let f = values.get(k);
-                        let mut data = 0.0;
-                        let mut model = 0.0;
-                        let mut rel = [0.0; 3];
-                        for (c, (&y, &fc)) in s.values.iter().zip(&f).take(channels).enumerate() {
-                            let mv = report.scale * fc;
-                            if removed.is_none() {
-                                let e = mv - y;
-                                rel[c] = e * e / (y * y + floor2);
-                            }
-                            data += y;
-                            model += mv;
-                        }
-                        let (data, model) = (data / channels as f64, model / channels as f64);
-                        let sample = PlotSample {
-                            theta: s.theta_deg,
-                            phi: s.phi_deg,
-                            dir: *dir,
-                            data,
-                            model,
-                            removed_by: *removed,
-                            log_ratio: log_ratio(data, model, floor),
-                        };
-                        if removed.is_none() {
-                            rels.push(rel);
-                        }
-                        sample
-                    })
-                    .collect();
-                (samples, rels)
-            })
-            .collect()
-    };
-    let blocks = samples_with_model();
-    // Whole blocks copied into one vector; the errors summed in sample order.
-    let mut samples: Vec<PlotSample> = Vec::with_capacity(m.samples.len());
+                None => {
+                    let n = block.len();
+                    let light = brtf_model::Directions {
+                        x: vec![incident.x; n],
+                        y: vec![incident.y; n],
+                        z: vec![incident.z; n],
+                    };
+                    bsdf.eval_batch(
+                        &light,
+                        &brtf_model::Directions::from_vectors(dirs),
+                        &mut values,
+                    );
+                }
+            }
+            let mut rels = Vec::new();
+            for (k, (((s, removed), dir), slot)) in
+                block.iter().zip(removed).zip(dirs).zip(out).enumerate()
+            {
+                let f = values.get(k);
+                let mut data = 0.0;
+                let mut model = 0.0;
+                let mut rel = [0.0; 3];
+                for (c, (&y, &fc)) in s.values.iter().zip(&f).take(channels).enumerate() {
+                    let mv = report.scale * fc;
+                    if removed.is_none() {
+                        let e = mv - y;
+                        rel[c] = e * e / (y * y + floor2);
+                    }
+                    data += y;
+                    model += mv;
+                }
+                let (data, model) = (data / channels as f64, model / channels as f64);
+                let sample = PlotSample {
+                    theta: s.theta_deg,
+                    phi: s.phi_deg,
+                    dir: *dir,
+                    data,
+                    model,
+                    removed_by: *removed,
+                    log_ratio: log_ratio(data, model, floor),
+                };
+                if removed.is_none() {
+                    rels.push(rel);
+                }
+                *slot = sample;
+            }
+            rels
+        })
+        .collect();
+    // The errors summed in sample order.
     let mut sum_rel = 0.0;
     let mut n_used = 0usize;
-    for (block, rels) in &blocks {
-        samples.extend_from_slice(block);
+    for rels in &rels_of_blocks {
         for rel in rels {
             for r in rel.iter().take(channels) {
                 sum_rel += r;
@@ -416,7 +419,6 @@ fn build(
         }
         n_used += rels.len();
     }
-    drop(blocks);
     if n_used != report.n_points {
         warnings.push(format!(
             "{}: {} samples are marked as fitted here but the fit used {}; \
