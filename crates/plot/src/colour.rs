@@ -30,10 +30,13 @@ pub fn diverging(t: f64) -> RGBColor {
         return MASKED;
     }
     let x = (t.clamp(-1.0, 1.0) + 1.0) * 0.5 * (RDBU.len() - 1) as f64;
-    let i = (x.floor() as usize).min(RDBU.len() - 2);
+    // x and the mixed channels are never negative: truncation is floor,
+    // and + 0.5 then truncation is round (no libm calls; a map colours
+    // every sample).
+    let i = (x as usize).min(RDBU.len() - 2);
     let f = x - i as f64;
     let (a, b) = (RDBU[i], RDBU[i + 1]);
-    let mix = |p: u8, q: u8| (p as f64 + f * (q as f64 - p as f64)).round() as u8;
+    let mix = |p: u8, q: u8| (p as f64 + f * (q as f64 - p as f64) + 0.5) as u8;
     RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
 }
 
