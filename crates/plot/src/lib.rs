@@ -221,7 +221,18 @@ fn render_and_write(
                 .map(|(k, job)| (k, render(job)))
                 .collect()
         };
-        let (mut done, ()) = rayon::join(|| pass(false), &grids);
+        let (mut done, ()) = rayon::join(
+            || {
+                // The maps' colours and numbers do not need the grids.
+                for job in jobs {
+                    if let Job::Map(map) = job {
+                        map.prepare();
+                    }
+                }
+                pass(false)
+            },
+            &grids,
+        );
         done.extend(pass(true));
         done.sort_by_key(|(k, _)| *k);
         let rendered: Result<Vec<Vec<PathBuf>>, PlotError> =

@@ -120,6 +120,28 @@ impl<'a> MapChart<'a> {
         [c.0, c.1, c.2]
     }
 
+    /// One colour per sample, looked up per pixel (made once).
+    fn colours(&self) -> &[[u8; 3]] {
+        self.colours.get_or_init(|| {
+            self.inc
+                .samples
+                .par_iter()
+                .with_min_len(4096)
+                .map(|s| self.colour_of(s))
+                .collect()
+        })
+    }
+
+    /// Makes what the map needs besides the nearest-sample grids (the
+    /// samples' colours and the panel's numbers), so that it can be made
+    /// while the grids are.
+    pub fn prepare(&self) {
+        rayon::join(
+            || self.colours(),
+            || self.stats.get_or_init(|| Stats::of(self.inc)),
+        );
+    }
+
     /// The RGBA raster of one hemisphere, `size` pixels square (made once).
     fn raster(&self, hemisphere: Hemisphere, size: u32) -> Vec<u8> {
         let slot = {
@@ -140,15 +162,7 @@ impl<'a> MapChart<'a> {
     /// Colours the pixels of one hemisphere by their nearest sample.
     fn paint(&self, hemisphere: Hemisphere, size: u32) -> Vec<u8> {
         let owner = self.inc.coverage(hemisphere).resampled(size);
-        // One colour per sample (a logarithm each), looked up per pixel.
-        let colours = self.colours.get_or_init(|| {
-            self.inc
-                .samples
-                .par_iter()
-                .with_min_len(4096)
-                .map(|s| self.colour_of(s))
-                .collect()
-        });
+        let colours = self.colours();
         let mut rgba = vec![0u8; owner.len() * 4];
         for (px, &o) in rgba.chunks_exact_mut(4).zip(&owner) {
             if o != disk::NONE {
