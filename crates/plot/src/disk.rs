@@ -19,10 +19,11 @@
 //! The nearest sample is exact wherever one lies within 1.5 pixels (found
 //! among the samples of the 3 × 3 pixels around). Pixels in gaps take the
 //! nearest of their neighbours' samples, propagated over the grid in two
-//! sweeps, then the nearest among the samples around that one: in rare
+//! sweeps (down and up; the upper and lower halves of the rows at the same
+//! time), then the nearest among the samples around that one: in rare
 //! pixels this is not the nearest sample but one a fraction of a pixel
 //! farther (at most a quarter of a pixel in the tests; on the 127 039-point
-//! pgII scan `golden_paper.txt`, 182 of 205 892 pixels, all inside the
+//! pgII scan `golden_paper.txt`, 183 of 205 892 pixels, all inside the
 //! coverage, differ from the exact search). A search per pixel costs as
 //! much as all the rest of the plots on ring-shaped scans.
 
@@ -127,7 +128,11 @@ impl Buckets {
             let row = (floor((RADIUS - y) / cell)).clamp(0, last) as usize;
             row * size + column
         };
-        let index: Vec<u32> = points.iter().map(|p| bucket(p) as u32).collect();
+        let index: Vec<u32> = points
+            .par_iter()
+            .with_min_len(8192)
+            .map(|p| bucket(p) as u32)
+            .collect();
         let mut start = vec![0u32; size * size + 1];
         for &i in &index {
             start[i as usize + 1] += 1;
@@ -362,9 +367,7 @@ impl Coverage {
         // row both ways): an approximate nearest-point transform. Its
         // point is the true nearest at nearly every pixel, and else one
         // a hair farther (see the module docs).
-        let offer = |nearest: &mut [Seed], at: usize, from: usize, x: f32, y: f32| {
-            let candidate = nearest[from];
-            let slot = &mut nearest[at];
+        let offer = |slot: &mut Seed, candidate: Seed, x: f32, y: f32| {
             if candidate.at == u32::MAX || candidate.at == slot.at {
                 return;
             }
@@ -375,46 +378,77 @@ impl Coverage {
                 *slot = Seed { d2, ..candidate };
             }
         };
-        // One row of a sweep: from the row `towards` (above or below, if
-        // any), then along the row in both directions. Final pixels
-        // (negative distance) are only sources.
-        let sweep_row = |nearest: &mut [Seed], j: usize, towards: Option<usize>| {
+        // One row `j` of a sweep: from the row before it in the sweep
+        // (`other`, above or below, if any), then along the row in both
+        // directions. Final pixels (negative distance) are only sources.
+        let sweep_row = |row: &mut [Seed], other: Option<&[Seed]>, j: usize| {
             let (lo, hi) = spans[j];
             let y = (RADIUS - (j as f64 + 0.5) * pixel) as f32;
             let x_of = |i: usize| (-RADIUS + (i as f64 + 0.5) * pixel) as f32;
             for i in lo..hi {
-                let at = j * width + i;
-                if nearest[at].d2 < 0.0 {
+                if row[i].d2 < 0.0 {
                     continue;
                 }
                 let x = x_of(i);
                 if i > lo {
-                    offer(nearest, at, at - 1, x, y);
+                    let left = row[i - 1];
+                    offer(&mut row[i], left, x, y);
                 }
-                if let Some(other) = towards {
-                    let from = other * width + i;
+                if let Some(other) = other {
                     if i > 0 {
-                        offer(nearest, at, from - 1, x, y);
+                        offer(&mut row[i], other[i - 1], x, y);
                     }
-                    offer(nearest, at, from, x, y);
+                    offer(&mut row[i], other[i], x, y);
                     if i + 1 < width {
-                        offer(nearest, at, from + 1, x, y);
+                        offer(&mut row[i], other[i + 1], x, y);
                     }
                 }
             }
             for i in (lo..hi.saturating_sub(1)).rev() {
-                let at = j * width + i;
-                if nearest[at].d2 >= 0.0 {
-                    offer(nearest, at, at + 1, x_of(i), y);
+                if row[i].d2 >= 0.0 {
+                    let right = row[i + 1];
+                    offer(&mut row[i], right, x_of(i), y);
                 }
             }
         };
-        for j in 0..width {
-            sweep_row(&mut nearest, j, j.checked_sub(1));
-        }
-        for j in (0..width).rev() {
-            sweep_row(&mut nearest, j, (j + 1 < width).then_some(j + 1));
-        }
+        // A sweep over the rows of `part` (whose first row is row `first`
+        // of the grid), down or up, the first row from `edge` (the row
+        // next to it in the sweep, outside `part`), if any.
+        let sweep = |part: &mut [Seed], first: usize, down: bool, edge: Option<&[Seed]>| {
+            let rows = part.len() / width;
+            for step in 0..rows {
+                let r = if down { step } else { rows - 1 - step };
+                if step == 0 {
+                    sweep_row(&mut part[r * width..(r + 1) * width], edge, first + r);
+                } else if down {
+                    let (before, rest) = part.split_at_mut(r * width);
+                    sweep_row(
+                        &mut rest[..width],
+                        Some(&before[(r - 1) * width..]),
+                        first + r,
+                    );
+                } else {
+                    let (rest, after) = part.split_at_mut((r + 1) * width);
+                    sweep_row(&mut rest[r * width..], Some(&after[..width]), first + r);
+                }
+            }
+        };
+        // The two halves of the rows at the same time: first the upper
+        // half down and the lower half up, then each the other way from a
+        // copy of the other half's row next to it. Every pixel is reached
+        // from every direction, as by one sweep down and one up.
+        let half = width / 2;
+        let (top, bottom) = nearest.split_at_mut(half * width);
+        rayon::join(
+            || sweep(top, 0, true, None),
+            || sweep(bottom, half, false, None),
+        );
+        let top_edge = (half > 0).then(|| top[(half - 1) * width..].to_vec());
+        let bottom_edge = (bottom.len() >= width).then(|| bottom[..width].to_vec());
+        rayon::join(
+            || sweep(top, 0, false, bottom_edge.as_deref()),
+            || sweep(bottom, half, true, top_edge.as_deref()),
+        );
         // Owners: the nearest point when within its reach. A propagated
         // point is first refined among the points around it (the true
         // nearest of a pixel in a gap is nearly always one of them).
