@@ -10,12 +10,14 @@
 //! * `plots/write_plots`: the same as `brtf plot` does it, with the file
 //!   read again and rebuilt with the fit's recipe.
 //! * `plots/load`: only the rebuild of the data ([`brtf_plot::prepare::load`],
-//!   with the nearest-sample grids, made at the same time as the model).
+//!   the model beside every sample; the nearest-sample grids are made on
+//!   first use, by `write_plots` beside the charts that do not need them).
 //! * `plots/coverage`: the nearest-sample grid of the front disk
 //!   ([`brtf_plot::disk::Coverage`]), which the map and the reflectance
 //!   chart share.
 //! * `plots/map_png`, `plots/map_svg`: the residual map alone, on data
-//!   loaded afresh each time (outside the timing, grids included).
+//!   loaded afresh each time (outside the timing; the grid of the front
+//!   disk, made on first use, inside it).
 
 use brtf_fit::{FitConfig, FitSetOptions, NoProgress, Recipe};
 use brtf_gonio::Hemisphere;

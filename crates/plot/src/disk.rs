@@ -304,7 +304,13 @@ impl Coverage {
         let far = (4.0 * spacing).max(min_reach);
         // A sample's own nearest-neighbour distance is only needed when a
         // pixel lies beyond the minimum reach: found then, and remembered.
-        let reach: Vec<OnceLock<f64>> = (0..points.len()).map(|_| OnceLock::new()).collect();
+        // Never when the minimum reach is as far as any pixel looks (dense
+        // scans): then no slots either.
+        let reach: Vec<OnceLock<f64>> = if far > min_reach {
+            (0..points.len()).map(|_| OnceLock::new()).collect()
+        } else {
+            Vec::new()
+        };
         let reach_of = |k: u32| {
             *reach[k as usize].get_or_init(|| {
                 let (x, y) = points[k as usize];
