@@ -331,7 +331,8 @@ impl DataRows<'_> {
     /// is kept, so [`DataRows::read_into`] goes on exactly as it would have.
     fn read_halves(&mut self, samples: &mut Vec<Sample>) {
         let bytes = self.text.as_bytes();
-        let rest = bytes.len() - self.pos;
+        // A last line without a line end leaves `pos` one past the end.
+        let rest = bytes.len().saturating_sub(self.pos);
         if rest < PARALLEL_BYTES {
             return;
         }
