@@ -400,7 +400,7 @@ impl Kernel<'_> {
         let channels = self.channels;
         let mut data = Vec::with_capacity((end - start) * channels);
         let mut sum_rel = 0.0;
-        let mut add = |i: usize, f: [f64; 3]| {
+        let add = |i: usize, f: [f64; 3]| {
             let s = &block.samples[i];
             for ch in 0..channels {
                 let row = i * channels + ch;
@@ -410,25 +410,38 @@ impl Kernel<'_> {
                 sum_rel += rel2;
             }
         };
-        if block.pairs.is_some() {
-            let mut scratch = GeometryBatch::new();
-            for i in start..end {
-                add(i, self.average(block, i, &mut scratch));
-            }
-        } else {
-            let mut run = Run::new();
-            for first in (start..end).step_by(RUN) {
-                let last = (first + RUN).min(end);
-                run.evaluate::<false>(self, block, first..last);
-                for i in first..last {
-                    add(i, run.value(i - first));
-                }
-            }
-        }
+        self.for_each_value(block, start..end, add);
         ChunkResult {
             finite: data.iter().all(|r| r.is_finite()),
             data,
             sum_rel,
+        }
+    }
+
+    /// Calls `visit(i, f)` with the model value `f` of each of `block`'s
+    /// samples `range`, in order: averaged over the sample's pairs for
+    /// patch-averaged data, else from the per-pair kernel in runs.
+    #[inline(always)]
+    fn for_each_value(
+        &self,
+        block: &Block<'_>,
+        range: Range<usize>,
+        mut visit: impl FnMut(usize, [f64; 3]),
+    ) {
+        if block.pairs.is_some() {
+            let mut scratch = GeometryBatch::new();
+            for i in range {
+                visit(i, self.average(block, i, &mut scratch));
+            }
+        } else {
+            let mut run = Run::new();
+            for first in range.clone().step_by(RUN) {
+                let last = (first + RUN).min(range.end);
+                run.evaluate::<false>(self, block, first..last);
+                for i in first..last {
+                    visit(i, run.value(i - first));
+                }
+            }
         }
     }
 
@@ -438,7 +451,7 @@ impl Kernel<'_> {
         let block = &self.blocks[b];
         let channels = self.channels;
         let mut sum = 0.0;
-        let mut add = |i: usize, f: [f64; 3]| {
+        let add = |i: usize, f: [f64; 3]| {
             let s = &block.samples[i];
             for ch in 0..channels {
                 let row = i * channels + ch;
@@ -447,21 +460,7 @@ impl Kernel<'_> {
                 sum += res * res;
             }
         };
-        if block.pairs.is_some() {
-            let mut scratch = GeometryBatch::new();
-            for i in start..end {
-                add(i, self.average(block, i, &mut scratch));
-            }
-        } else {
-            let mut run = Run::new();
-            for first in (start..end).step_by(RUN) {
-                let last = (first + RUN).min(end);
-                run.evaluate::<false>(self, block, first..last);
-                for i in first..last {
-                    add(i, run.value(i - first));
-                }
-            }
-        }
+        self.for_each_value(block, start..end, add);
         sum
     }
 
