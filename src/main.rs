@@ -46,9 +46,9 @@ enum Command {
 }
 
 // glibc's malloc hands big freed blocks back to the kernel and faults them
-// in again page by page on the next allocation: a golden_paper fit took
-// 18.6k page faults, about a fifth of its CPU time. mimalloc keeps and
-// reuses them (about 400 faults). See docs/benchmarks.md.
+// in again page by page on the next allocation: a lean golden_paper fit
+// took 18.6k page faults, and a quarter of its CPU time was the kernel's.
+// mimalloc keeps and reuses them (about 330 faults). See docs/benchmarks.md.
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 

@@ -414,14 +414,7 @@ impl Recipe {
         );
         let (mut measurement, conversion, removed_by) = converted?;
         // The conversions keep the samples and their order.
-        debug_assert_eq!(measurement.samples.len(), solid_angles.per_sample_sr.len());
-        for (sample, w) in measurement
-            .samples
-            .iter_mut()
-            .zip(&solid_angles.per_sample_sr)
-        {
-            sample.solid_angle_sr = Some(*w);
-        }
+        measurement.set_solid_angles(&solid_angles);
         let weighting = match (self.weights, solid_angles.source) {
             (WeightRule::Uniform, _) => Weighting::Uniform,
             (WeightRule::SolidAngle, SolidAngleSource::File) => Weighting::FileSolidAngles,

@@ -295,10 +295,7 @@ impl DataRows<'_> {
         let bytes = self.text.as_bytes();
         self.read_halves(samples);
         loop {
-            let (pos, rows) = match self.channels {
-                Channels::Y => plain_rows::<1>(bytes, self.pos, samples),
-                Channels::Xyz => plain_rows::<3>(bytes, self.pos, samples),
-            };
+            let (pos, rows) = plain_rows_of(self.channels, bytes, self.pos, samples);
             self.pos = pos;
             self.lines_before += rows;
             let mut lines = Lines::resume(self.text, self.pos, self.lines_before);
@@ -321,9 +318,7 @@ impl DataRows<'_> {
             samples.push(sample);
         }
     }
-}
 
-impl DataRows<'_> {
     /// Reads the rows of a large file as two halves on two threads, split at
     /// a line start: when the first half is plain to its end, both halves'
     /// samples are kept and `self` moves past them; otherwise the second
@@ -345,9 +340,8 @@ impl DataRows<'_> {
             return;
         };
         let channels = self.channels;
-        let rows = |slice: &[u8], from: usize, out: &mut Vec<Sample>| match channels {
-            Channels::Y => plain_rows::<1>(slice, from, out),
-            Channels::Xyz => plain_rows::<3>(slice, from, out),
+        let rows = |slice: &[u8], from: usize, out: &mut Vec<Sample>| {
+            plain_rows_of(channels, slice, from, out)
         };
         let mut second = Vec::with_capacity(samples.capacity().saturating_sub(samples.len()) / 2);
         let ((end, first_rows), (second_end, second_rows)) = rayon::join(
@@ -366,6 +360,19 @@ impl DataRows<'_> {
 
 /// Files with more data bytes than this are read in two halves at once.
 const PARALLEL_BYTES: usize = 1 << 20;
+
+/// [`plain_rows`] with the number of values of `channels`.
+fn plain_rows_of(
+    channels: Channels,
+    bytes: &[u8],
+    pos: usize,
+    samples: &mut Vec<Sample>,
+) -> (usize, usize) {
+    match channels {
+        Channels::Y => plain_rows::<1>(bytes, pos, samples),
+        Channels::Xyz => plain_rows::<3>(bytes, pos, samples),
+    }
+}
 
 /// Reads plain rows of θ, φ and `VALUES` values from `bytes[pos..]` until
 /// one is not plain; returns where that row starts and how many rows were

@@ -90,10 +90,17 @@ impl Measurement {
     /// [`solid_angles`], so the weights survive later selections.
     pub fn fill_solid_angles(&mut self) -> SolidAngleSource {
         let weights = solid_angles(self);
+        self.set_solid_angles(&weights);
+        weights.source
+    }
+
+    /// Sets every sample's [`Sample::solid_angle_sr`] from `weights`
+    /// (computed for the same samples, in the same order).
+    pub fn set_solid_angles(&mut self, weights: &SolidAngles) {
+        debug_assert_eq!(self.samples.len(), weights.per_sample_sr.len());
         for (sample, w) in self.samples.iter_mut().zip(&weights.per_sample_sr) {
             sample.solid_angle_sr = Some(*w);
         }
-        weights.source
     }
 }
 
@@ -121,8 +128,8 @@ pub fn voronoi_solid_angles(samples: &[Sample]) -> Vec<f64> {
 /// The layout of each hemisphere's valid directions, front then back
 /// (`None` for a hemisphere without samples).
 pub fn detect_layout(samples: &[Sample]) -> [Option<Layout>; 2] {
-    [Hemisphere::Front, Hemisphere::Back].map(|hemisphere| {
-        let (_, directions) = hemisphere_directions(samples, hemisphere);
+    let [front, back] = both_hemispheres(samples);
+    [(Hemisphere::Front, front), (Hemisphere::Back, back)].map(|(hemisphere, (_, directions))| {
         if directions.is_empty() {
             None
         } else if rings::ring_areas(&directions, hemisphere).is_some() {
@@ -172,20 +179,4 @@ fn both_hemispheres(samples: &[Sample]) -> [Directions; 2] {
         }
     }
     split
-}
-
-/// The indices and `(θ, φ)` of the valid samples in `hemisphere`.
-fn hemisphere_directions(samples: &[Sample], hemisphere: Hemisphere) -> Directions {
-    let mut indices = Vec::new();
-    let mut directions = Vec::new();
-    for (i, s) in samples.iter().enumerate() {
-        let valid = s.theta_deg.is_finite()
-            && (0.0..=180.0).contains(&s.theta_deg)
-            && s.phi_deg.is_finite();
-        if valid && s.hemisphere() == hemisphere {
-            indices.push(i);
-            directions.push((s.theta_deg, s.phi_deg));
-        }
-    }
-    (indices, directions)
 }
