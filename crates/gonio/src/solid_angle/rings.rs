@@ -44,11 +44,23 @@ struct Ring {
 
 /// The cell solid angles (sr) of `directions` (θ, φ in degrees, valid and
 /// all in `hemisphere`) when they form a ring layout, else `None`.
+#[cfg(test)]
 pub(crate) fn ring_areas(directions: &[(f64, f64)], hemisphere: Hemisphere) -> Option<Vec<f64>> {
-    if has_wide_run(directions, hemisphere) {
+    ring_areas_of(directions.len(), |k| directions[k], hemisphere)
+}
+
+/// [`ring_areas`] of the `count` directions `direction(k)`: the run test
+/// reads only θ, and the directions are gathered only for a sort.
+pub(crate) fn ring_areas_of(
+    count: usize,
+    direction: impl Fn(usize) -> (f64, f64),
+    hemisphere: Hemisphere,
+) -> Option<Vec<f64>> {
+    if has_wide_run((0..count).map(|k| direction(k).0), hemisphere) {
         return None;
     }
-    sorted_ring_areas(directions, hemisphere)
+    let directions: Vec<(f64, f64)> = (0..count).map(direction).collect();
+    sorted_ring_areas(&directions, hemisphere)
 }
 
 /// Width of the θ' bins of [`has_wide_run`], degrees: two values in
@@ -67,10 +79,10 @@ const RUN_BINS: usize = 7;
 /// [`sorted_ring_areas`] would find no ring layout. One pass, no sort: the
 /// scattered layouts of real scans are refused at a fraction of the
 /// sort's cost. `false` says nothing.
-fn has_wide_run(directions: &[(f64, f64)], hemisphere: Hemisphere) -> bool {
+fn has_wide_run(thetas: impl Iterator<Item = f64>, hemisphere: Hemisphere) -> bool {
     let bins = (90.0 / RUN_BIN_DEG) as usize + 1;
     let mut occupied = vec![false; bins];
-    for &(theta, _) in directions {
+    for theta in thetas {
         let from_normal = match hemisphere {
             Hemisphere::Front => theta,
             Hemisphere::Back => 180.0 - theta,
@@ -275,7 +287,10 @@ mod tests {
                     .map(|s| (s.theta_deg, s.phi_deg))
                     .collect();
                 if directions.len() > 1000 {
-                    assert!(has_wide_run(&directions, hemisphere), "{file}");
+                    assert!(
+                        has_wide_run(directions.iter().map(|d| d.0), hemisphere),
+                        "{file}"
+                    );
                 }
                 sets.push((format!("{file} {hemisphere:?}"), directions, hemisphere));
             }
@@ -311,7 +326,12 @@ mod tests {
         }
         // Not vacuous: some sets are rings, some are refused by the run test.
         assert!(sets.iter().any(|(_, d, h)| ring_areas(d, *h).is_some()));
-        assert!(sets.iter().filter(|(_, d, h)| has_wide_run(d, *h)).count() >= 4);
+        assert!(
+            sets.iter()
+                .filter(|(_, d, h)| has_wide_run(d.iter().map(|d| d.0), *h))
+                .count()
+                >= 4
+        );
     }
 
     #[test]

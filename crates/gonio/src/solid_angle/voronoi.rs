@@ -73,13 +73,20 @@ const GRID: f64 = 1.0 / (1u64 << 30) as f64;
 /// Number of ghost points closing the outer Voronoi cells.
 const GHOSTS: usize = 32;
 
-/// Equal-area Voronoi cell areas (sr) of the directions `(θ, φ)` in degrees,
-/// all valid and in `hemisphere`.
-pub(crate) fn hemisphere_areas(directions: &[(f64, f64)], hemisphere: Hemisphere) -> Vec<f64> {
-    let points: Vec<[f64; 2]> = directions
-        .par_iter()
+/// Equal-area Voronoi cell areas (sr) of the `count` directions
+/// `direction(k)` = `(θ, φ)` in degrees, all valid and in `hemisphere`.
+pub(crate) fn hemisphere_areas(
+    count: usize,
+    direction: impl Fn(usize) -> (f64, f64) + Sync,
+    hemisphere: Hemisphere,
+) -> Vec<f64> {
+    let points: Vec<[f64; 2]> = (0..count)
+        .into_par_iter()
         .with_min_len(4096)
-        .map(|&(theta, phi)| project(theta, phi, hemisphere))
+        .map(|k| {
+            let (theta, phi) = direction(k);
+            project(theta, phi, hemisphere)
+        })
         .collect();
     disk_voronoi_areas(&points)
 }
