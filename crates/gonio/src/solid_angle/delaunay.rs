@@ -4,9 +4,12 @@
 //! The points to triangulate all lie strictly inside a convex polygon whose
 //! corners are given first (the ghost ring of `voronoi`). That polygon is
 //! triangulated as a fan, then every point is inserted in Hilbert-curve
-//! order: a visibility walk from a triangle of the point's neighbour on the
-//! curve (or of the previous point) finds the triangle that holds the new
-//! point, the triangle is split in three and Lawson flips restore the
+//! order: a visibility walk finds the triangle that holds the new point
+//! (starting, when the point's neighbour on the curve is already in, from
+//! the triangle about that neighbour that faces the point, found by turning
+//! about it with one orientation test per triangle; otherwise from the
+//! previous point's triangle), the triangle is split in three and Lawson
+//! flips restore the
 //! Delaunay property. Because every point is inside the polygon, the convex
 //! hull never changes and no "outside" case exists.
 //!
@@ -762,16 +765,19 @@ impl Inserter<'_> {
     /// round is several.
     fn insert(&mut self, p: u32) -> Option<()> {
         let i = p as usize;
-        let before = self.triangle_of[i - 1];
-        let after = self.triangle_of.get(i + 1).copied().unwrap_or(NONE);
-        let start = if before != NONE {
-            before
-        } else if after != NONE {
-            after
+        let point = self.points[i];
+        let neighbour = if self.triangle_of[i - 1] != NONE {
+            Some(p - 1)
+        } else if self.triangle_of.get(i + 1).is_some_and(|&t| t != NONE) {
+            Some(p + 1)
         } else {
-            self.last
+            None
         };
-        let t = self.locate(start, self.points[i])?;
+        let (first, count) = match neighbour {
+            Some(n) => self.turn_towards(n, point),
+            None => (4 * self.last, 3),
+        };
+        let t = self.locate(first, count, point)?;
         self.split(t, p);
         while let Some(e) = self.stack.pop() {
             self.legalize(e);
@@ -780,13 +786,67 @@ impl Inserter<'_> {
         Some(())
     }
 
+    /// Where the walk towards `point` starts, from the inserted vertex `n`
+    /// (`point`'s neighbour along the curve, usually a Delaunay neighbour
+    /// of it): turning about `n` from its known triangle, one orientation
+    /// test per triangle, to the one whose corner at `n` holds `point`.
+    /// Returns that triangle's halfedge opposite `n` and 1 (the only edge
+    /// left to test), or, when the turn goes on for too long, a halfedge of
+    /// the triangle reached and 3. A hint only: the walk that follows is
+    /// right from any start.
+    fn turn_towards(&self, n: u32, point: [f64; 2]) -> (u32, u32) {
+        const MAX_TURN: usize = 16;
+        let t = self.triangle_of[n as usize];
+        let record = self.mesh[t as usize];
+        let corner = if record[0] == n {
+            0
+        } else if record[1] == n {
+            1
+        } else {
+            2
+        };
+        // `out` runs from n to a; the triangle is (n, a, b).
+        let mut out = 4 * t + corner;
+        let at = self.point(n);
+        let a = self.point(record[((corner + 1) % 3) as usize]);
+        if orient(at, a, point) < 0.0 {
+            // `point` is clockwise of n → a: turn clockwise.
+            for _ in 0..MAX_TURN {
+                let twin = self.twin(out);
+                if twin == NONE {
+                    break;
+                }
+                out = next4(twin);
+                let c = self.point(self.vertex(next4(out)));
+                if orient(at, c, point) >= 0.0 {
+                    return (next4(out), 1);
+                }
+            }
+        } else {
+            // Counter-clockwise while `point` is beyond n → b.
+            for _ in 0..MAX_TURN {
+                let b = self.point(self.vertex(prev4(out)));
+                if orient(at, b, point) <= 0.0 {
+                    return (next4(out), 1);
+                }
+                let twin = self.twin(prev4(out));
+                if twin == NONE {
+                    break;
+                }
+                out = twin;
+            }
+        }
+        (out & !3, 3)
+    }
+
     /// The triangle containing `point` (inside or on its boundary), by a
-    /// visibility walk from triangle `start` that crosses any edge `point`
-    /// lies strictly beyond, trying the edges in turn after the one it came
-    /// in by (which `point` is known to lie beyond, so is not tried again).
-    fn locate(&self, start: u32, point: [f64; 2]) -> Option<u32> {
-        let mut t = start;
-        let (mut first, mut count) = (4 * t, 3);
+    /// visibility walk that starts by testing the `count` edges of a
+    /// triangle from halfedge `first` on and crosses any edge `point` lies
+    /// strictly beyond, trying the edges in turn after the one it came in
+    /// by (which `point` is known to lie beyond, so is not tried again).
+    fn locate(&self, first: u32, count: u32, point: [f64; 2]) -> Option<u32> {
+        let (mut first, mut count) = (first, count);
+        let mut t = first >> 2;
         // A Delaunay walk visits each triangle at most once.
         'walk: for _ in 0..=self.mesh.len() {
             let record = self.mesh[t as usize];
