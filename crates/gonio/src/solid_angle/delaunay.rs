@@ -718,6 +718,10 @@ fn prev4(e: u32) -> u32 {
     if e & 3 == 0 { e + 2 } else { e - 1 }
 }
 
+/// How far along the spatial order the walk's start looks for a point
+/// that is already in (in each direction).
+const NEIGHBOUR_REACH: usize = 16;
+
 /// Incremental insertion into a triangulation held as one 32-byte record
 /// per triangle (its three vertices, a spare, its three halfedges' twins,
 /// a spare), so that a step of the walk or a flip touches one cache line
@@ -759,20 +763,32 @@ impl Inserter<'_> {
         self.points[v as usize]
     }
 
-    /// Inserts point `p`. The walk starts next to p's neighbour in the
-    /// spatial order (the points' indices) when that one is already in:
-    /// a step or two away, where the previous point of the same insertion
-    /// round is several.
+    /// Inserts point `p`. The walk starts next to a neighbour of p in the
+    /// spatial order (the points' indices) that is already in, if one is
+    /// within [`NEIGHBOUR_REACH`] places: a step or two away, where the
+    /// previous point of the same insertion round is several.
     fn insert(&mut self, p: u32) -> Option<()> {
         let i = p as usize;
         let point = self.points[i];
-        let neighbour = if self.triangle_of[i - 1] != NONE {
-            Some(p - 1)
-        } else if self.triangle_of.get(i + 1).is_some_and(|&t| t != NONE) {
-            Some(p + 1)
-        } else {
-            None
+        // The nearest points along the curve before and after p that are
+        // in (i - 1 in the last round, which holds half the points; a few
+        // places away in the earlier, sparser rounds), and of those two the
+        // one nearer p: where the curve steps from one scan path to the
+        // next, the other is on another path, and the walk from it is long.
+        let inserted = |j: usize| self.triangle_of.get(j).is_some_and(|&t| t != NONE);
+        let below = (1..=NEIGHBOUR_REACH.min(i))
+            .map(|d| i - d)
+            .find(|&j| inserted(j));
+        let above = (1..=NEIGHBOUR_REACH).map(|d| i + d).find(|&j| inserted(j));
+        let distance2 = |j: usize| {
+            let q = self.points[j];
+            (q[0] - point[0]).powi(2) + (q[1] - point[1]).powi(2)
         };
+        let neighbour = match (below, above) {
+            (Some(b), Some(a)) => Some(if distance2(a) < distance2(b) { a } else { b }),
+            (b, a) => b.or(a),
+        }
+        .map(|j| j as u32);
         let (first, count) = match neighbour {
             Some(n) => self.turn_towards(n, point),
             None => (4 * self.last, 3),
