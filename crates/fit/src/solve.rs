@@ -21,6 +21,9 @@ pub(crate) struct Stage {
     /// Its passes compute what the report uses (the sandwich's middle
     /// term, `rms_rel`); only the final fit's solution is reported.
     report: bool,
+    /// LM's Hessian gets the large-residual correction of
+    /// [`crate::problem::Secant`].
+    secant: bool,
 }
 
 impl Stage {
@@ -34,6 +37,7 @@ impl Stage {
         gtol: 1e-14,
         patience: 8,
         report: false,
+        secant: false,
     };
     /// The starts of an all-incidence fit stop at a relative change of
     /// 1e-3: over many incidences they only have to find a basin, and
@@ -54,6 +58,7 @@ impl Stage {
         gtol: 1e-6,
         patience: 200,
         report: true,
+        secant: true,
     };
 }
 
@@ -170,6 +175,7 @@ impl Solver<'_> {
         *problem.history.borrow_mut() = seed;
         problem.u = u0.clone();
         problem.report = stage.report;
+        problem.secant = stage.secant.then(Default::default);
         let (problem, report) = LevenbergMarquardt::new()
             .with_ftol(stage.tolerance)
             .with_xtol(stage.tolerance)

@@ -83,6 +83,7 @@ mod tests {
             jacobian: r,
             rms_rel: f64::NAN,
             meat: None,
+            model: None,
         };
         let (cost, m, n) = (5.0, 103, 3);
         let errors = standard_errors(&pass, cost, m, n);
