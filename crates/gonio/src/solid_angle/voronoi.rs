@@ -112,6 +112,9 @@ fn snap(v: f64) -> f64 {
 /// radius is 3√2 cos(π/32) ≈ 4.2).
 const FAST_PATH_RADIUS: f64 = 2.0 * DISK_RADIUS;
 
+/// Points per piece of the parallel passes over all the points.
+const PASS_CHUNK: usize = 16_384;
+
 /// Areas of the Voronoi cells of `points` clipped to the disk of radius
 /// [`DISK_RADIUS`]. Coincident points share their cell equally.
 pub fn disk_voronoi_areas(points: &[[f64; 2]]) -> Vec<f64> {
@@ -119,19 +122,32 @@ pub fn disk_voronoi_areas(points: &[[f64; 2]]) -> Vec<f64> {
     if n == 0 {
         return Vec::new();
     }
-    // One pass: every point finite and within the fast path's radius, and
-    // the bounding box (the frame of the Hilbert curve).
-    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-    let mut accepted = true;
-    for p in points {
-        accepted &= p[0].is_finite()
-            && p[1].is_finite()
-            && p[0] * p[0] + p[1] * p[1] <= FAST_PATH_RADIUS * FAST_PATH_RADIUS;
-        for k in 0..2 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
+    // One parallel pass: every point finite and within the fast path's
+    // radius, and the bounding box (the frame of the Hilbert curve).
+    let (accepted, lo, hi) = points
+        .par_chunks(PASS_CHUNK)
+        .map(|chunk| {
+            let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+            let mut accepted = true;
+            for p in chunk {
+                accepted &= p[0].is_finite()
+                    && p[1].is_finite()
+                    && p[0] * p[0] + p[1] * p[1] <= FAST_PATH_RADIUS * FAST_PATH_RADIUS;
+                for k in 0..2 {
+                    lo[k] = lo[k].min(p[k]);
+                    hi[k] = hi[k].max(p[k]);
+                }
+            }
+            (accepted, lo, hi)
+        })
+        .reduce(
+            || (true, [f64::INFINITY; 2], [f64::NEG_INFINITY; 2]),
+            |a, b| {
+                let lo = [a.1[0].min(b.1[0]), a.1[1].min(b.1[1])];
+                let hi = [a.2[0].max(b.2[0]), a.2[1].max(b.2[1])];
+                (a.0 && b.0, lo, hi)
+            },
+        );
     if !accepted || n >= (u32::MAX / 8) as usize {
         return reference_disk_voronoi_areas(points);
     }
@@ -173,29 +189,53 @@ pub fn disk_voronoi_areas(points: &[[f64; 2]]) -> Vec<f64> {
             group_of[i as usize] = first + g;
         }
     }
-    let Some(cell_areas) = cell_areas(&vertices, halves) else {
+    let Some(sums) = cell_sums(&vertices, halves) else {
         return reference_disk_voronoi_areas(points);
     };
-    group_of
+    // Each point's share of its cell, the per-thread sums added in a fixed
+    // order (so the result does not depend on scheduling).
+    let areas: Vec<f64> = group_of
         .par_iter()
         .with_min_len(4096)
-        .map(|&g| cell_areas[g as usize] / group_size[g as usize] as f64)
-        .collect()
+        .map(|&g| {
+            let i = GHOSTS + g as usize;
+            let cell = sums.iter().map(|part| part[i]).sum::<f64>().abs();
+            cell / group_size[g as usize] as f64
+        })
+        .collect();
+    // A cell that is not finite (never seen): the reference instead.
+    if areas.par_iter().all(|a| a.is_finite()) {
+        areas
+    } else {
+        reference_disk_voronoi_areas(points)
+    }
 }
 
 /// An abscissa with about half of `points` on either side (from a
-/// histogram over `lo..hi`, so it does not depend on their order), or
-/// `None` if one side would be empty.
+/// histogram over `lo..hi`, counted in parallel pieces; it does not depend
+/// on their order), or `None` if one side would be empty.
 fn middle_abscissa(points: &[[f64; 2]], lo: f64, hi: f64) -> Option<f64> {
     const BINS: usize = 4096;
     let width = (hi - lo) / BINS as f64;
     if width <= 0.0 {
         return None;
     }
-    let mut counts = vec![0usize; BINS];
-    for p in points {
-        counts[(((p[0] - lo) / width) as usize).min(BINS - 1)] += 1;
-    }
+    let counts = points
+        .par_chunks(PASS_CHUNK)
+        .map(|chunk| {
+            let mut counts = vec![0usize; BINS];
+            for p in chunk {
+                counts[(((p[0] - lo) / width) as usize).min(BINS - 1)] += 1;
+            }
+            counts
+        })
+        .reduce(
+            || vec![0usize; BINS],
+            |mut a, b| {
+                a.iter_mut().zip(&b).for_each(|(a, b)| *a += b);
+                a
+            },
+        );
     let mut below = 0;
     for (bin, &count) in counts.iter().enumerate() {
         below += count;
@@ -423,11 +463,10 @@ impl delaunay::EdgeVisitor for CellSums {
     }
 }
 
-/// Disk-clipped Voronoi cell areas of the non-ghost vertices, in order, or
-/// `None` if the triangulation gave up or a cell is not finite (never
-/// seen). The per-thread sums are added in a fixed order, so the result
-/// does not depend on scheduling.
-fn cell_areas(vertices: &[[f64; 2]], halves: Option<(usize, f64)>) -> Option<Vec<f64>> {
+/// The per-thread sums of the disk-clipped Voronoi cells of the
+/// triangulation's vertices (ghosts included), in a fixed order, or `None`
+/// if the triangulation gave up.
+fn cell_sums(vertices: &[[f64; 2]], halves: Option<(usize, f64)>) -> Option<Vec<Vec<f64>>> {
     let (_, sums) = delaunay::triangulate_spatially_ordered(
         vertices,
         GHOSTS,
@@ -436,12 +475,7 @@ fn cell_areas(vertices: &[[f64; 2]], halves: Option<(usize, f64)>) -> Option<Vec
             vertices: vertices.len(),
         },
     )?;
-    let areas: Vec<f64> = (GHOSTS..vertices.len())
-        .into_par_iter()
-        .with_min_len(4096)
-        .map(|i| sums.iter().map(|part| part[i]).sum::<f64>().abs())
-        .collect();
-    areas.iter().all(|a| a.is_finite()).then_some(areas)
+    Some(sums)
 }
 
 /// Areas of the Voronoi cells of `points` clipped to the disk of radius
