@@ -31,9 +31,10 @@
 //! scans' long near-collinear paths. With two threads and enough points
 //! ([`disk_voronoi_areas`]):
 //!
-//! 1. one pass checks the points and takes their bounding box; a histogram
-//!    of x gives a split line with about half the points on either side
-//!    (from the histogram, so independent of the input order);
+//! 1. one pass, in parallel pieces, checks the points and takes their
+//!    bounding box; a histogram of x (counted the same way) gives a split
+//!    line with about half the points on either side (from the histogram,
+//!    so independent of the input order);
 //! 2. each half, on its own thread, computes its points' Hilbert keys
 //!    (four curve levels per table look-up), sorts them (a stable radix
 //!    sort, ties by the coordinates) and merges coincident points, then
@@ -46,7 +47,8 @@
 //!    chasing around vertices;
 //! 4. the seam between the halves is triangulated again and checked, and
 //!    its halfedges add their terms the same way (module `delaunay`);
-//! 5. the per-thread sums are added in a fixed order.
+//! 5. each point's weight is its cell's per-thread sums, added in a fixed
+//!    order, divided by the number of points sharing the cell.
 //!
 //! With one thread the same steps run on all the points at once. The
 //! Voronoi diagram does not depend on the triangulation method, so both,
