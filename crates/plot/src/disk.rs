@@ -17,7 +17,9 @@
 //! quadrature of the hemispherical integrals.
 //!
 //! The nearest sample is exact wherever one lies within 1.5 pixels (found
-//! among the samples of the 3 × 3 pixels around). Pixels in gaps take the
+//! among the samples of the 3 × 3 pixels around; the pixel's own first,
+//! and when one of those is nearer than half a pixel, the others cannot
+//! be nearer and are not looked at). Pixels in gaps take the
 //! nearest of their neighbours' samples, propagated over the grid in two
 //! sweeps (down and up; the upper and lower halves of the rows at the same
 //! time), then the nearest among the samples around that one: in rare
@@ -205,30 +207,49 @@ impl Buckets {
         best
     }
 
-    /// Nearest point (ties: the lower index) to (x, y), the centre of
-    /// bucket (i, j), among the points of the 3 × 3 buckets around it: its
-    /// position in bucket order and its squared distance.
-    fn nearest_around(&self, i: usize, j: usize, x: f64, y: f64) -> Option<(u32, f64)> {
-        let (c0, c1) = (i.saturating_sub(1), (i + 1).min(self.size - 1));
-        let mut best: Option<(u32, f64)> = None;
-        for row in j.saturating_sub(1)..=(j + 1).min(self.size - 1) {
-            let base = row * self.size;
-            let (a, b) = (self.start[base + c0], self.start[base + c1 + 1]);
-            for at in a..b {
-                let (px, py) = self.sorted[at as usize];
-                let d2 = (px - x) * (px - x) + (py - y) * (py - y);
-                if best.is_none_or(|(bp, b)| d2 < b || (d2 == b && self.before(at, bp))) {
-                    best = Some((at, d2));
-                }
+    /// Offers the points at bucket positions `a..b` to `best`, the nearest
+    /// to (x, y) so far (ties: the lower index). The outcome does not
+    /// depend on the order of the offers.
+    #[inline(always)]
+    fn offer(&self, a: u32, b: u32, x: f64, y: f64, best: &mut Best) {
+        for at in a..b {
+            let (px, py) = self.sorted[at as usize];
+            let d2 = (px - x) * (px - x) + (py - y) * (py - y);
+            if d2 < best.d2 || (d2 == best.d2 && self.before(at, best.at)) {
+                *best = Best { at, d2 };
             }
         }
-        best
     }
 
-    /// The point at bucket position `a` has the lower index than the one at `b`.
-    fn before(&self, a: u32, b: u32) -> bool {
-        self.items[a as usize] < self.items[b as usize]
+    /// Offers the points of buckets `c0..=c1` of bucket row `row` to `best`.
+    #[inline(always)]
+    fn offer_row(&self, row: usize, c0: usize, c1: usize, x: f64, y: f64, best: &mut Best) {
+        let base = row * self.size;
+        self.offer(self.start[base + c0], self.start[base + c1 + 1], x, y, best);
     }
+
+    /// The point at bucket position `a` has the lower index than the one
+    /// at `b` (any point comes before none, `b` = `u32::MAX`).
+    fn before(&self, a: u32, b: u32) -> bool {
+        self.items
+            .get(b as usize)
+            .is_none_or(|&item| self.items[a as usize] < item)
+    }
+}
+
+/// The nearest point to a pixel's centre found so far: its position in
+/// bucket order (`u32::MAX`: none yet) and squared distance.
+#[derive(Debug, Clone, Copy)]
+struct Best {
+    at: u32,
+    d2: f64,
+}
+
+impl Best {
+    const NONE: Best = Best {
+        at: u32::MAX,
+        d2: f64::INFINITY,
+    };
 }
 
 /// A pixel's nearest point so far while [`Coverage::new`] propagates
@@ -283,7 +304,8 @@ impl Coverage {
     /// Assigns every pixel of a `size × size` grid to its nearest point
     /// `ids[k]` at `points[k]`, if that point is within its reach: its
     /// distance to its own nearest neighbour, but at least `min_reach`
-    /// (projected units) and one pixel.
+    /// (projected units) and one pixel. Points with a non-finite
+    /// coordinate own no pixel.
     pub fn new(points: &[(f64, f64)], ids: &[u32], size: u32, min_reach: f64) -> Coverage {
         debug_assert_eq!(points.len(), ids.len());
         let mut owner = vec![NONE; (size * size) as usize];
@@ -349,19 +371,59 @@ impl Coverage {
         // when nearer than 1.5 pixels (every other point is farther), which
         // is every pixel of a dense region.
         let exact2 = (1.5 * pixel * (1.0 - 1e-9)).powi(2);
+        // Every point of another bucket is at least half a pixel from the
+        // pixel's centre, less rounding (the margin).
+        let half2 = (0.5 * pixel * (1.0 - 1e-9)).powi(2);
         let mut nearest = vec![Seed::NONE; width * width];
         nearest
             .par_chunks_mut(width)
             .enumerate()
             .for_each(|(j, row)| {
                 let (lo, hi) = spans[j];
+                let base = j * width;
                 for (i, slot) in row.iter_mut().enumerate().take(hi).skip(lo) {
                     let (x, y) = centre(i, j);
-                    if let Some((at, d2)) = buckets.nearest_around(i, j, x, y) {
-                        let (px, py) = buckets.sorted[at as usize];
+                    // The pixel's own bucket first: a point nearer than
+                    // half a pixel beats every point of the 8 around.
+                    let mut best = Best::NONE;
+                    let own = base + i;
+                    buckets.offer(buckets.start[own], buckets.start[own + 1], x, y, &mut best);
+                    if best.d2 >= half2 {
+                        if i > 0 {
+                            buckets.offer(
+                                buckets.start[own - 1],
+                                buckets.start[own],
+                                x,
+                                y,
+                                &mut best,
+                            );
+                        }
+                        if i + 1 < width {
+                            buckets.offer(
+                                buckets.start[own + 1],
+                                buckets.start[own + 2],
+                                x,
+                                y,
+                                &mut best,
+                            );
+                        }
+                        let (c0, c1) = (i.saturating_sub(1), (i + 1).min(width - 1));
+                        if j > 0 {
+                            buckets.offer_row(j - 1, c0, c1, x, y, &mut best);
+                        }
+                        if j + 1 < width {
+                            buckets.offer_row(j + 1, c0, c1, x, y, &mut best);
+                        }
+                    }
+                    if best.at != u32::MAX {
+                        let (px, py) = buckets.sorted[best.at as usize];
                         *slot = Seed {
-                            at,
-                            d2: if d2 <= exact2 { -1.0 } else { d2 as f32 },
+                            at: best.at,
+                            d2: if best.d2 <= exact2 {
+                                -1.0
+                            } else {
+                                best.d2 as f32
+                            },
                             x: px as f32,
                             y: py as f32,
                         };
@@ -470,20 +532,23 @@ impl Coverage {
                         continue;
                     }
                     let (x, y) = centre(i, j);
-                    let mut at = seed.at;
-                    let (px, py) = buckets.sorted[at as usize];
-                    let mut d2 = (px - x) * (px - x) + (py - y) * (py - y);
+                    let (px, py) = buckets.sorted[seed.at as usize];
+                    let mut best = Best {
+                        at: seed.at,
+                        d2: (px - x) * (px - x) + (py - y) * (py - y),
+                    };
                     if seed.d2 >= 0.0 {
+                        // The seed's own bucket is among these: starting
+                        // from the seed, a point must beat it.
                         let bi = floor((px + RADIUS) / pixel).clamp(0, last) as usize;
                         let bj = floor((RADIUS - py) / pixel).clamp(0, last) as usize;
-                        if let Some((a, d)) = buckets.nearest_around(bi, bj, x, y)
-                            && (d < d2 || (d == d2 && buckets.before(a, at)))
-                        {
-                            (at, d2) = (a, d);
+                        let (c0, c1) = (bi.saturating_sub(1), (bi + 1).min(width - 1));
+                        for r in bj.saturating_sub(1)..=(bj + 1).min(width - 1) {
+                            buckets.offer_row(r, c0, c1, x, y, &mut best);
                         }
                     }
-                    let k = buckets.items[at as usize];
-                    let d = d2.sqrt();
+                    let k = buckets.items[best.at as usize];
+                    let d = best.d2.sqrt();
                     if d <= far && (d <= min_reach || d <= reach_of(k)) {
                         *cell = ids[k as usize];
                     }
@@ -658,6 +723,60 @@ mod tests {
             differ * 200 <= covered,
             "{differ} of {covered} pixels differ"
         );
+    }
+
+    #[test]
+    fn pixels_near_a_point_get_the_exact_nearest() {
+        // Points on the pixels' edges and corners (where a pixel's own
+        // bucket and its neighbours' meet), at their centres, repeated,
+        // and pairs at equal distances from a pixel centre: wherever a
+        // point lies within 1.5 pixels, the owner is the nearest point,
+        // the lower index on ties (ids here rise with the index).
+        let size = 64u32;
+        let pixel = 2.0 * RADIUS / size as f64;
+        let edge = |k: i32| -RADIUS + k as f64 * pixel;
+        let centre = |k: i32| -RADIUS + (k as f64 + 0.5) * pixel;
+        let mut pts = Vec::new();
+        for k in 0..800 {
+            let (i, j) = (k % 50 + 7, (k / 50 * 7 + k * 3) % 50 + 7);
+            let p = match k % 5 {
+                0 => (edge(i), centre(j)),
+                1 => (centre(i), edge(j)),
+                2 => (edge(i), edge(j)),
+                3 => (centre(i) + 0.3 * pixel, centre(j) - 0.45 * pixel),
+                // Mirror images about a pixel centre: a tie.
+                _ => (centre(i) - 0.7 * pixel, centre(j)),
+            };
+            pts.push(p);
+            if k % 5 == 4 {
+                pts.push((centre(i) + 0.7 * pixel, centre(j)));
+            }
+        }
+        pts.extend_from_within(..30);
+        let ids: Vec<u32> = (0..pts.len() as u32).map(|k| 5 + 2 * k).collect();
+        // Every pixel within 1.5 pixels of a point is covered.
+        let c = Coverage::new(&pts, &ids, size, 1.6 * pixel);
+        let mut checked = 0;
+        for j in 0..size as i32 {
+            for i in 0..size as i32 {
+                let (x, y) = (centre(i), -centre(j));
+                if x * x + y * y > RADIUS * RADIUS {
+                    continue;
+                }
+                let (k, d2) = pts
+                    .iter()
+                    .map(|&(px, py)| (px - x) * (px - x) + (py - y) * (py - y))
+                    .enumerate()
+                    .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)))
+                    .unwrap();
+                if d2 < (1.49 * pixel).powi(2) {
+                    let got = c.owner[(j as u32 * size + i as u32) as usize];
+                    assert_eq!(got, ids[k], "pixel ({i}, {j})");
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked > 1000, "{checked}");
     }
 
     #[test]
