@@ -76,9 +76,9 @@ const RUN_BINS: usize = 7;
 /// True when the directions' θ' values (from the hemisphere's normal)
 /// occupy [`RUN_BINS`] neighbouring bins of [`RUN_BIN_DEG`]: then they
 /// chain into a ring wider than [`MAX_RING_SPREAD_DEG`], and
-/// [`sorted_ring_areas`] would find no ring layout. One pass, no sort: the
-/// scattered layouts of real scans are refused at a fraction of the
-/// sort's cost. `false` says nothing.
+/// [`sorted_ring_areas`] would find no ring layout. One pass, no sort,
+/// stopping at the first such run: the scattered layouts of real scans are
+/// refused after a few directions. `false` says nothing.
 fn has_wide_run(thetas: impl Iterator<Item = f64>, hemisphere: Hemisphere) -> bool {
     let bins = (90.0 / RUN_BIN_DEG) as usize + 1;
     let mut occupied = vec![false; bins];
@@ -89,14 +89,19 @@ fn has_wide_run(thetas: impl Iterator<Item = f64>, hemisphere: Hemisphere) -> bo
         };
         // Values outside 0..=90 (none for valid directions) are left out:
         // fewer occupied bins only make a proof less likely.
-        if (0.0..=90.0).contains(&from_normal) {
-            occupied[((from_normal / RUN_BIN_DEG) as usize).min(bins - 1)] = true;
+        if !(0.0..=90.0).contains(&from_normal) {
+            continue;
         }
-    }
-    let mut run = 0;
-    for &o in &occupied {
-        run = if o { run + 1 } else { 0 };
-        if run >= RUN_BINS {
+        let bin = ((from_normal / RUN_BIN_DEG) as usize).min(bins - 1);
+        if occupied[bin] {
+            continue;
+        }
+        occupied[bin] = true;
+        // The run through the newly occupied bin: on a scattered layout one
+        // is found after a few directions, and the rest are not read.
+        let below = occupied[..bin].iter().rev().take_while(|&&o| o).count();
+        let above = occupied[bin + 1..].iter().take_while(|&&o| o).count();
+        if below + 1 + above >= RUN_BINS {
             return true;
         }
     }
