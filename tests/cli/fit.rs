@@ -679,7 +679,8 @@ fn adequacy_separates_a_good_fit_from_inadequate_ones() {
 
 /// Multi-start never ends above any of its candidates or above a single
 /// start: the best few ends (always with the data-driven start's) are
-/// judged on every sample, and the full fit starts from the best. Checked
+/// judged on every sample, and the full fit starts from the best; ends of
+/// one basin are one candidate, which needs no judging. Checked
 /// on the GGX 45° scan written in Mountain format (where one start once
 /// won from a bound: 93.16 against 91.35 for one start) with every
 /// residual kind.
@@ -733,11 +734,20 @@ fn multi_start_is_never_worse_than_its_candidates_or_one_start() {
             one.cost
         );
         let judged: Vec<f64> = m.starts.iter().filter_map(|s| s.full_cost).collect();
-        assert!(
-            !judged.is_empty() && m.starts[0].full_cost.is_some(),
-            "{:?}",
-            m.starts
-        );
+        if judged.is_empty() {
+            // One candidate: the best three ends and the data-driven
+            // start's found one basin, so their subsample costs agree.
+            let mut costs: Vec<f64> = m.starts.iter().map(|s| s.subsample_cost).collect();
+            costs.sort_by(f64::total_cmp);
+            let agree = |c: f64| (c - costs[0]).abs() <= 1e-6 * c.abs();
+            assert!(
+                costs.iter().take(3).all(|&c| agree(c)) && agree(m.starts[0].subsample_cost),
+                "{residual}: {:?}",
+                m.starts
+            );
+        } else {
+            assert!(m.starts[0].full_cost.is_some(), "{:?}", m.starts);
+        }
         for c in judged {
             assert!(
                 m.cost <= c * (1.0 + 1e-12),

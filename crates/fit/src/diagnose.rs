@@ -20,7 +20,7 @@ use crate::data::IncidenceData;
 use crate::recipe::PreparedMeasurement;
 use crate::report::FitReport;
 use brtf_gonio::Hemisphere;
-use brtf_model::{Bsdf, Material};
+use brtf_model::{Bsdf, Directions, Material, RgbBatch};
 use glam::DVec3;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -130,13 +130,30 @@ fn fitted_model(prepared: &PreparedMeasurement, data: &IncidenceData, bsdf: &Bsd
             .map(|&i| luminance(prepared.model_value(bsdf, i), channels))
             .collect();
     }
+    // In pieces through the vectorised batch kernel (the same values as
+    // `Bsdf::eval` to rounding).
     let light = prepared.measurement.incident_direction();
-    data.samples
-        .par_iter()
-        .with_min_len(4096)
-        .map(|s| luminance(bsdf.eval(light, s.view), channels))
-        .collect()
+    let pieces: Vec<Vec<f64>> = data
+        .samples
+        .par_chunks(MODEL_PIECE)
+        .map(|piece| {
+            let lights = Directions::from_vectors(&vec![light; piece.len()]);
+            let mut views = Directions::with_capacity(piece.len());
+            for s in piece {
+                views.push(s.view);
+            }
+            let mut values = RgbBatch::default();
+            bsdf.eval_batch(&lights, &views, &mut values);
+            (0..piece.len())
+                .map(|i| luminance([values.r[i], values.g[i], values.b[i]], channels))
+                .collect()
+        })
+        .collect();
+    pieces.concat()
 }
+
+/// Samples per piece of [`fitted_model`].
+const MODEL_PIECE: usize = 4096;
 
 /// [`measured_integrals`] with the model's values `model` from
 /// [`fitted_model`]. |cos θ| comes from the fitter's directions `data`
@@ -233,8 +250,8 @@ fn peak_offset(prepared: &PreparedMeasurement, data: &IncidenceData, model: &[f6
         let median = *all.select_nth_unstable_by(mid, f64::total_cmp).1;
         (sum.normalize_or_zero(), brightest / median.max(1e-300))
     };
-    let (data_peak, contrast) = centroid(&|s| s.1);
-    let (model_peak, _) = centroid(&|s| s.2);
+    let ((data_peak, contrast), (model_peak, _)) =
+        rayon::join(|| centroid(&|s| s.1), || centroid(&|s| s.2));
     if contrast < 2.0 || data_peak == DVec3::ZERO || model_peak == DVec3::ZERO {
         return None;
     }

@@ -17,6 +17,7 @@
 
 use crate::data::{FitSample, GateCount, IncidenceData, Weighting};
 use brtf_gonio::{Gate, GateContext, Measurement, Quantity, SolidAngleSource};
+use glam::DVec3;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -396,7 +397,14 @@ pub struct PreparedMeasurement {
     /// Patch-averaged data: every sample's (light, view) pairs, in file
     /// order (set by [`crate::klems`]).
     pub patch_pairs: Option<std::sync::Arc<crate::data::PatchPairs>>,
+    /// Every sample's [`brtf_gonio::Sample::direction`], in file order:
+    /// made once, beside the solid angles, for the gates and the fitter.
+    pub directions: Vec<DVec3>,
 }
+
+/// What [`Recipe::convert_and_gate`] makes: the converted measurement,
+/// per sample the gate that removed it, and every sample's direction.
+type Converted = (Measurement, Conversion, Vec<Option<usize>>, Vec<DVec3>);
 
 impl Recipe {
     /// Applies the recipe to `measurement`, read from `source`.
@@ -412,7 +420,7 @@ impl Recipe {
             || brtf_gonio::solid_angles(&measurement),
             || self.convert_and_gate(&measurement, source),
         );
-        let (mut measurement, conversion, removed_by) = converted?;
+        let (mut measurement, conversion, removed_by, directions) = converted?;
         // The conversions keep the samples and their order.
         measurement.set_solid_angles(&solid_angles);
         let weighting = match (self.weights, solid_angles.source) {
@@ -441,16 +449,18 @@ impl Recipe {
             gates,
             weighting,
             patch_pairs: None,
+            directions,
         })
     }
 
     /// The colour conversion, the fitted quantity (step 3) and the gates:
-    /// the converted measurement and, per sample, the first gate it fails.
+    /// the converted measurement, per sample the first gate it fails, and
+    /// every sample's direction.
     fn convert_and_gate(
         &self,
         measurement: &Measurement,
         source: &str,
-    ) -> Result<(Measurement, Conversion, Vec<Option<usize>>), RecipeError> {
+    ) -> Result<Converted, RecipeError> {
         let (measurement, conversion) = if self.colour == ColourConversion::XyzToRadianceRgb
             && measurement.channels == brtf_gonio::Channels::Xyz
         {
@@ -462,19 +472,23 @@ impl Recipe {
         } else {
             self.convert(measurement, source)?
         };
-        // Each sample is removed by the first gate it fails, if any.
+        // Each sample is removed by the first gate it fails, if any. The
+        // conversion keeps the angles, so the directions are the same.
         let context = GateContext::of(&measurement);
-        let removed_by = measurement
+        let (removed_by, directions) = measurement
             .samples
             .par_iter()
             .with_min_len(SAMPLE_PIECE)
             .map(|sample| {
-                self.selections
+                let direction = sample.direction();
+                let removed = self
+                    .selections
                     .iter()
-                    .position(|gate| !gate.keeps(sample, &context))
+                    .position(|gate| !gate.keeps_at(sample, || direction, &context));
+                (removed, direction)
             })
-            .collect();
-        Ok((measurement, conversion, removed_by))
+            .unzip();
+        Ok((measurement, conversion, removed_by, directions))
     }
 
     /// Step 3: the fitted quantity.
@@ -569,7 +583,7 @@ impl PreparedMeasurement {
             Some(pairs) => pairs.average(bsdf, index),
             None => bsdf.eval(
                 self.measurement.incident_direction(),
-                self.measurement.samples[index].direction(),
+                self.directions[index],
             ),
         }
     }
@@ -606,16 +620,16 @@ impl PreparedMeasurement {
             theta_in: self.measurement.incidence.theta_deg,
             phi_in: self.measurement.incidence.phi_deg,
             channels: self.channels(),
-            // In parallel pieces: each direction costs two sin_cos.
             samples: self
                 .measurement
                 .samples
                 .par_iter()
                 .zip(&self.removed_by)
+                .zip(&self.directions)
                 .with_min_len(SAMPLE_PIECE)
-                .filter(|(_, removed)| removed.is_none())
-                .map(|(s, _)| FitSample {
-                    view: s.direction(),
+                .filter(|((_, removed), _)| removed.is_none())
+                .map(|((s, _), &view)| FitSample {
+                    view,
                     value: s.values,
                     weight: if uniform {
                         1.0

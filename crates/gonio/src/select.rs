@@ -134,13 +134,25 @@ impl Gate {
 
     /// True when `sample` passes the gate.
     pub fn keeps(&self, sample: &Sample, context: &GateContext) -> bool {
+        self.keeps_at(sample, || sample.direction(), context)
+    }
+
+    /// [`Gate::keeps`] with the sample's direction from `direction`
+    /// (called only by the gates that need it), for a caller that has the
+    /// directions already: each costs two `sin_cos`.
+    pub fn keeps_at(
+        &self,
+        sample: &Sample,
+        direction: impl FnOnce() -> DVec3,
+        context: &GateContext,
+    ) -> bool {
         let values = &sample.values[..context.channels];
         match *self {
             Gate::Unavailable => values.iter().all(|v| v.is_finite()),
             Gate::Hemisphere { keep } => sample.hemisphere() == keep,
             Gate::ThetaCap { max_deg } => sample.theta_deg.min(180.0 - sample.theta_deg) <= max_deg,
             Gate::BeamMask { half_angle_deg } => {
-                sample.direction().dot(context.light) < half_angle_deg.to_radians().cos()
+                direction().dot(context.light) < half_angle_deg.to_radians().cos()
             }
             Gate::MinValue { min } => values.iter().all(|&v| v.is_finite() && v >= min),
             Gate::AzimuthBand {
