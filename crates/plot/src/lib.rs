@@ -170,14 +170,15 @@ const WRITERS: usize = 4;
 /// Renders every job and writes its files, then `last` (the report) once
 /// every job rendered; returns the paths in `jobs` order, then `last`'s.
 /// The files are written by threads of their own, so that rendering never
-/// waits for the disk (each write syncs). `grids` makes the nearest-sample
-/// grids, at the same time as the charts that do not need them; the maps
-/// and the reflectance chart render after it.
+/// waits for the disk (each write syncs). `grids`, if any, makes the
+/// nearest-sample grids, at the same time as the charts that do not need
+/// them; the maps and the reflectance chart render after it. Without it
+/// (the grids are made) every chart renders in one pass.
 fn render_and_write(
     jobs: &[Job],
     dir: &Path,
     last: (PathBuf, Vec<u8>),
-    grids: impl Fn() + Sync,
+    grids: Option<&(dyn Fn() + Sync)>,
 ) -> Result<Vec<PathBuf>, PlotError> {
     let (send, receive) = std::sync::mpsc::channel::<(PathBuf, Vec<u8>)>();
     let receive = std::sync::Mutex::new(receive);
@@ -212,28 +213,42 @@ fn render_and_write(
             }
             Ok(paths)
         };
-        // First the charts without grids, beside the grids, then the rest
-        // (each in `jobs` order).
-        let pass = |with_grids: bool| -> Vec<(usize, Result<Vec<PathBuf>, PlotError>)> {
+        // The charts `pass` selects, in `jobs` order.
+        let pass = |select: &(dyn Fn(&Job) -> bool + Sync)| -> Vec<(usize, Result<Vec<PathBuf>, PlotError>)> {
             jobs.par_iter()
                 .enumerate()
-                .filter(|(_, job)| job.needs_coverage() == with_grids)
+                .filter(|(_, job)| select(job))
                 .map(|(k, job)| (k, render(job)))
                 .collect()
         };
-        let (mut done, ()) = rayon::join(
-            || {
-                // The maps' colours and numbers do not need the grids.
-                for job in jobs {
-                    if let Job::Map(map) = job {
-                        map.prepare();
-                    }
+        // The maps' colours and numbers (they do not need the grids), made
+        // before any chart renders: both renderings of a map read them.
+        let prepare_maps = || {
+            for job in jobs {
+                if let Job::Map(map) = job {
+                    map.prepare();
                 }
-                pass(false)
-            },
-            &grids,
-        );
-        done.extend(pass(true));
+            }
+        };
+        let mut done = match grids {
+            // First the charts without grids, beside the grids, then the
+            // rest.
+            Some(grids) => {
+                let (mut done, ()) = rayon::join(
+                    || {
+                        prepare_maps();
+                        pass(&|job| !job.needs_coverage())
+                    },
+                    grids,
+                );
+                done.extend(pass(&|job| job.needs_coverage()));
+                done
+            }
+            None => {
+                prepare_maps();
+                pass(&|_| true)
+            }
+        };
         done.sort_by_key(|(k, _)| *k);
         let rendered: Result<Vec<Vec<PathBuf>>, PlotError> =
             done.into_iter().map(|(_, paths)| paths).collect();
@@ -295,13 +310,33 @@ fn plot(
     }
     let plots = dir.join("plots");
     let tags = prepare::tags(&result.incidences);
-    let loaded: Vec<Result<Incidence, String>> = (0..result.incidences.len())
-        .into_par_iter()
-        .map(|k| match prepared.get(k) {
-            Some(data) => prepare::from_prepared(result, k, tags[k].clone(), data),
-            None => prepare::load(result, k, tags[k].clone(), dir, &options.search_dirs),
-        })
-        .collect();
+    // The fitted data's nearest-sample grids need only the directions and
+    // the selection: they are made while the incidences are built (the
+    // model beside every sample). Nothing here is made on first use, so
+    // no thread waits for another's lazy value inside the joins.
+    let (loaded, grids): (Vec<Result<Incidence, String>>, Vec<_>) = rayon::join(
+        || {
+            (0..result.incidences.len())
+                .into_par_iter()
+                .map(|k| match prepared.get(k) {
+                    Some(data) => prepare::from_prepared(result, k, tags[k].clone(), data),
+                    None => prepare::load(result, k, tags[k].clone(), dir, &options.search_dirs),
+                })
+                .collect()
+        },
+        || {
+            prepared
+                .par_iter()
+                .take(result.incidences.len())
+                .map(prepare::grids_of_prepared)
+                .collect()
+        },
+    );
+    for (inc, grids) in loaded.iter().zip(grids) {
+        if let Ok(inc) = inc {
+            inc.set_grids(grids);
+        }
+    }
     let mut warnings: Vec<String> = Vec::new();
     for l in &loaded {
         match l {
@@ -474,24 +509,30 @@ fn plot(
     });
     // The report is written with the plots' files, once they all rendered.
     let report_path = dir.join("report.html");
+    // Every grid a chart asks for (a map without fitted samples draws an
+    // empty front disk).
+    let wanted = |inc: &Incidence| {
+        let mut hemispheres = inc.hemispheres();
+        if hemispheres.is_empty() {
+            hemispheres.push(brtf_gonio::Hemisphere::Front);
+        }
+        hemispheres
+    };
     let grids = || {
         incs.par_iter().for_each(|inc| {
-            // Every grid a chart asks for (a map without fitted samples
-            // draws an empty front disk).
-            let mut hemispheres = inc.hemispheres();
-            if hemispheres.is_empty() {
-                hemispheres.push(brtf_gonio::Hemisphere::Front);
-            }
-            for hemisphere in hemispheres {
+            for hemisphere in wanted(inc) {
                 inc.coverage(hemisphere);
             }
         })
     };
+    let made = incs
+        .iter()
+        .all(|inc| wanted(inc).into_iter().all(|h| inc.has_grid(h)));
     let files = render_and_write(
         &jobs,
         &plots,
         (report_path.clone(), html.into_bytes()),
-        grids,
+        (!made).then_some(&grids as &(dyn Fn() + Sync)),
     )?;
     remove_stale(&plots, &files);
     Ok(Written {

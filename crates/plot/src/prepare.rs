@@ -89,9 +89,12 @@ pub struct Incidence {
     /// Things the reader should know about this incidence's plots.
     pub warnings: Vec<String>,
     /// Nearest-sample grids of the front and back disks, made on first
-    /// use (`write_plots` makes them while the charts that do not need
-    /// them render).
+    /// use or handed over by [`Incidence::set_grids`] (`write_plots` makes
+    /// them from the fitted data while the model values are computed, or
+    /// while the charts that do not need them render).
     coverage: [OnceLock<Coverage>; 2],
+    /// [`Incidence::hemispheres`], found on first use.
+    hemispheres: OnceLock<Vec<Hemisphere>>,
     /// The samples near the plane of incidence, for the cuts.
     near_plane: OnceLock<Vec<(f64, f64, usize)>>,
     /// The cut of the first requested plane tolerance, with that request:
@@ -129,6 +132,26 @@ impl Incidence {
                 (s.theta, s.dir, s.used(), s.data)
             })
         })
+    }
+
+    /// The grid of `hemisphere` is made.
+    pub(crate) fn has_grid(&self, hemisphere: Hemisphere) -> bool {
+        let slot = match hemisphere {
+            Hemisphere::Front => 0,
+            Hemisphere::Back => 1,
+        };
+        self.coverage[slot].get().is_some()
+    }
+
+    /// Takes the grids made by [`grids_of_prepared`] from the data this
+    /// incidence was built from (index 0 front, 1 back); a grid already
+    /// made is kept.
+    pub(crate) fn set_grids(&self, grids: [Option<Coverage>; 2]) {
+        for (slot, grid) in self.coverage.iter().zip(grids) {
+            if let Some(grid) = grid {
+                let _ = slot.set(grid);
+            }
+        }
     }
 
     /// The samples near the plane of incidence, `(offset from the plane,
@@ -179,16 +202,17 @@ impl Incidence {
         })
     }
 
-    /// Hemispheres that hold fitted samples (front first).
+    /// Hemispheres that hold fitted samples (front first), found once
+    /// (the maps and the integrals ask several times).
     pub fn hemispheres(&self) -> Vec<Hemisphere> {
-        [Hemisphere::Front, Hemisphere::Back]
-            .into_iter()
-            .filter(|h| {
-                self.samples
-                    .iter()
-                    .any(|s| s.used() && s.hemisphere() == *h)
+        self.hemispheres
+            .get_or_init(|| {
+                used_hemispheres(self.samples.len(), |k| {
+                    let s = &self.samples[k];
+                    (s.theta, s.used())
+                })
             })
-            .collect()
+            .clone()
     }
 
     /// Mirror direction (θ_in, φ_in + 180°).
@@ -203,6 +227,79 @@ impl Incidence {
     pub fn log_ratio(&self, s: &PlotSample) -> f64 {
         s.log_ratio
     }
+}
+
+/// Hemispheres that hold fitted samples (front first) among `n` samples,
+/// sample `k` given by `sample(k)` as `(θ_out in degrees, fitted)`.
+fn used_hemispheres(n: usize, sample: impl Fn(usize) -> (f64, bool)) -> Vec<Hemisphere> {
+    let mut found = [false; 2];
+    for k in 0..n {
+        let (theta, used) = sample(k);
+        if used {
+            match Hemisphere::of_theta(theta) {
+                Hemisphere::Front => found[0] = true,
+                Hemisphere::Back => found[1] = true,
+            }
+            if found == [true; 2] {
+                break;
+            }
+        }
+    }
+    [Hemisphere::Front, Hemisphere::Back]
+        .into_iter()
+        .zip(found)
+        .filter_map(|(h, f)| f.then_some(h))
+        .collect()
+}
+
+/// The nearest-sample grids the plots of one incidence draw (index 0
+/// front, 1 back: the hemispheres with fitted samples, else the front),
+/// made from the data the fit fitted, before the incidence is built: they
+/// need only the directions and which samples were fitted with data. The
+/// same grids [`Incidence::coverage`] makes from the built incidence (none
+/// when the selection does not match the samples).
+pub(crate) fn grids_of_prepared(prepared: &PreparedMeasurement) -> [Option<Coverage>; 2] {
+    let m = &prepared.measurement;
+    let channels = prepared.channels();
+    let n = m.samples.len();
+    if prepared.removed_by.len() != n {
+        // Not data `build` accepts as it is: the grids are made from the
+        // built incidence instead.
+        return [None, None];
+    }
+    let mut hemispheres = used_hemispheres(n, |k| {
+        (m.samples[k].theta_deg, prepared.removed_by[k].is_none())
+    });
+    if hemispheres.is_empty() {
+        hemispheres.push(Hemisphere::Front);
+    }
+    let mut grids = [None, None];
+    for hemisphere in hemispheres {
+        let slot = match hemisphere {
+            Hemisphere::Front => 0,
+            Hemisphere::Back => 1,
+        };
+        grids[slot] = Some(disk_grid(hemisphere, n, |k| {
+            let s = &m.samples[k];
+            (
+                s.theta_deg,
+                s.direction(),
+                prepared.removed_by[k].is_none(),
+                channel_mean(&s.values, channels),
+            )
+        }));
+    }
+    grids
+}
+
+/// The mean of the first `channels` values, summed in order (as
+/// [`PlotSample::data`] is).
+fn channel_mean(values: &[f64], channels: usize) -> f64 {
+    let mut sum = 0.0;
+    for &v in values.iter().take(channels) {
+        sum += v;
+    }
+    sum / channels as f64
 }
 
 /// The nearest-sample grid of one hemisphere over `n` samples, sample
@@ -454,6 +551,7 @@ fn build(
         channels,
         warnings,
         coverage: [OnceLock::new(), OnceLock::new()],
+        hemispheres: OnceLock::new(),
         near_plane: OnceLock::new(),
         cut: OnceLock::new(),
     };

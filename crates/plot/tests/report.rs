@@ -162,6 +162,10 @@ fn no_incidence_is_an_error_and_a_bad_fit_json_names_its_line() {
     assert!(err.contains("cannot read"), "{err}");
 }
 
+/// The data handed over draw byte for byte the plots of the files read
+/// again: the same model values, and the nearest-sample grids made from the
+/// fitted data (beside the model values) equal the ones made from the
+/// incidence.
 #[test]
 fn the_fits_own_data_draw_the_same_plots_as_the_files() {
     let kind = brtf_model::MaterialKind::Metal;

@@ -103,12 +103,9 @@ pub fn integrals(result: &FitResult, incs: &[Option<&Incidence>]) -> Vec<Integra
             let mut data = [None; 2];
             let mut model_same = [None; 2];
             if let Some(inc) = inc {
+                let used = inc.hemispheres();
                 for (h, hemisphere) in [Hemisphere::Front, Hemisphere::Back].iter().enumerate() {
-                    if !inc
-                        .samples
-                        .iter()
-                        .any(|s| s.used() && s.hemisphere() == *hemisphere)
-                    {
+                    if !used.contains(hemisphere) {
                         continue;
                     }
                     let coverage = inc.coverage(*hemisphere);
