@@ -218,20 +218,39 @@ pub fn render_svg(chart: &impl Chart) -> Result<String, PlotError> {
 pub fn render_png(chart: &impl Chart) -> Result<Vec<u8>, PlotError> {
     register_fonts();
     let (w, h) = chart.size();
-    let mut pixels = vec![255u8; (w * h * 3) as usize];
+    // The thread's pixel buffer of the last chart, reused: a fresh one of a
+    // few MB is faulted in page by page, which cost more than the drawing.
+    let mut pixels = PIXELS.with(|p| std::mem::take(&mut *p.borrow_mut()));
+    pixels.clear();
+    pixels.resize((w * h * 3) as usize, 255);
     let canvas = Canvas {
         mode: Mode::Png,
         pending: RefCell::new(Vec::new()),
     };
-    {
+    let drawn = {
         let root = BitMapBackend::with_buffer(&mut pixels, (w, h)).into_drawing_area();
         root.fill(&WHITE)
             .msg()
             .and_then(|_| chart.draw(&root, &canvas))
             .and_then(|_| root.present().msg())
-            .map_err(|m| draw_error(chart, m))?;
-    }
-    encode_png(w, h, png::ColorType::Rgb, &pixels).map_err(|m| draw_error(chart, m))
+            .map_err(|m| draw_error(chart, m))
+    };
+    let encoded = drawn.and_then(|()| {
+        encode_png(w, h, png::ColorType::Rgb, &pixels).map_err(|m| draw_error(chart, m))
+    });
+    PIXELS.with(|p| {
+        let mut kept = p.borrow_mut();
+        if pixels.capacity() > kept.capacity() {
+            *kept = pixels;
+        }
+    });
+    encoded
+}
+
+thread_local! {
+    /// The pixel buffer [`render_png`] reuses on this thread (the largest
+    /// so far, at most a chart's: a few MB per thread).
+    static PIXELS: RefCell<Vec<u8>> = const { RefCell::new(Vec::new()) };
 }
 
 /// Encodes 8-bit pixels as PNG.
@@ -310,6 +329,58 @@ pub fn write_chart(chart: &impl Chart, dir: &Path) -> Result<Vec<PathBuf>, PlotE
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A filled square on white, `size` pixels wide.
+    struct Square {
+        size: (u32, u32),
+        colour: RGBColor,
+    }
+
+    impl Chart for Square {
+        fn name(&self) -> String {
+            "square".into()
+        }
+        fn size(&self) -> (u32, u32) {
+            self.size
+        }
+        fn draw<DB: DrawingBackend>(&self, root: &Area<DB>, _: &Canvas) -> Result<(), String> {
+            root.draw(&Rectangle::new([(10, 10), (40, 30)], self.colour.filled()))
+                .msg()
+        }
+    }
+
+    #[test]
+    fn a_reused_pixel_buffer_draws_what_a_fresh_one_draws() {
+        let small = Square {
+            size: (60, 50),
+            colour: RGBColor(200, 30, 10),
+        };
+        let fresh = std::thread::spawn(|| {
+            render_png(&Square {
+                size: (60, 50),
+                colour: RGBColor(200, 30, 10),
+            })
+            .unwrap()
+        })
+        .join()
+        .unwrap();
+        // A larger chart of another colour first leaves its pixels in the
+        // thread's buffer.
+        let large = Square {
+            size: (300, 200),
+            colour: RGBColor(0, 0, 250),
+        };
+        render_png(&large).unwrap();
+        let reused = render_png(&small).unwrap();
+        assert_eq!(reused, fresh);
+        let decoder = png::Decoder::new(std::io::Cursor::new(reused));
+        let mut reader = decoder.read_info().unwrap();
+        let mut pixels = vec![0; reader.output_buffer_size().unwrap()];
+        reader.next_frame(&mut pixels).unwrap();
+        let at = |x: usize, y: usize| &pixels[(y * 60 + x) * 3..(y * 60 + x) * 3 + 3];
+        assert_eq!(at(20, 20), &[200, 30, 10]);
+        assert_eq!(at(50, 40), &[255, 255, 255]);
+    }
 
     #[test]
     fn base64_matches_the_rfc_examples() {

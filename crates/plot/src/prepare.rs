@@ -312,17 +312,36 @@ fn disk_grid(
     n: usize,
     sample: impl Fn(usize) -> (f64, DVec3, bool, f64) + Sync,
 ) -> Coverage {
-    let (ids, points): (Vec<u32>, Vec<(f64, f64)>) = (0..n)
+    // In pieces of their own, then joined once into vectors of the exact
+    // size (no growing, no list of partial vectors).
+    const PIECE: usize = 8192;
+    type Piece = (Vec<u32>, Vec<(f64, f64)>);
+    let pieces: Vec<Piece> = (0..n.div_ceil(PIECE))
         .into_par_iter()
-        .with_min_len(4096)
-        .filter_map(|k| {
-            let (theta, dir, used, data) = sample(k);
-            let keep = Hemisphere::of_theta(theta) == hemisphere
-                && dir.is_finite()
-                && (!used || data.is_finite());
-            keep.then(|| (k as u32, disk::project(dir, hemisphere)))
+        .map(|p| {
+            let range = p * PIECE..((p + 1) * PIECE).min(n);
+            let mut ids = Vec::with_capacity(range.len());
+            let mut points = Vec::with_capacity(range.len());
+            for k in range {
+                let (theta, dir, used, data) = sample(k);
+                if Hemisphere::of_theta(theta) == hemisphere
+                    && dir.is_finite()
+                    && (!used || data.is_finite())
+                {
+                    ids.push(k as u32);
+                    points.push(disk::project(dir, hemisphere));
+                }
+            }
+            (ids, points)
         })
-        .unzip();
+        .collect();
+    let total = pieces.iter().map(|(ids, _)| ids.len()).sum();
+    let mut ids = Vec::with_capacity(total);
+    let mut points = Vec::with_capacity(total);
+    for (i, p) in &pieces {
+        ids.extend_from_slice(i);
+        points.extend_from_slice(p);
+    }
     Coverage::new(
         &points,
         &ids,
@@ -415,12 +434,6 @@ fn build(
     // squared relative errors of the fitted ones (per channel) are summed
     // afterwards in sample order.
     const BLOCK: usize = 4096;
-    let dirs: Vec<DVec3> = m
-        .samples
-        .par_iter()
-        .with_min_len(BLOCK)
-        .map(|s| s.direction())
-        .collect();
     // Each block: its samples, and the errors of its fitted ones in order.
     // Written in place, block by block (no second copy of every sample).
     let unset = PlotSample {
@@ -437,9 +450,12 @@ fn build(
         .par_chunks_mut(BLOCK)
         .zip(m.samples.par_chunks(BLOCK))
         .zip(removed_by.par_chunks(BLOCK))
-        .zip(dirs.par_chunks(BLOCK))
         .enumerate()
-        .map(|(b, (((out, block), removed), dirs))| {
+        .map(|(b, ((out, block), removed))| {
+            // The block's directions (not a vector of all of them: less
+            // fresh memory to fault in).
+            let dirs: Vec<DVec3> = block.iter().map(|s| s.direction()).collect();
+            let dirs = &dirs[..];
             // Patch-averaged (Klems) data are compared with the averaged
             // model ([`PreparedMeasurement::model_value`]); else the model
             // is the BSDF at each direction, evaluated for the whole block
