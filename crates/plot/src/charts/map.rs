@@ -110,10 +110,10 @@ impl<'a> MapChart<'a> {
         }
     }
 
-    /// Colour of a sample.
-    fn colour_of(&self, s: &crate::prepare::PlotSample) -> [u8; 3] {
+    /// Colour of a sample, `ln_ratio` being `ln` of [`MapChart::ratio`].
+    fn colour_of(&self, s: &crate::prepare::PlotSample, ln_ratio: f64) -> [u8; 3] {
         let c = if s.used() {
-            colour::diverging(self.inc.log_ratio(s) / self.ratio.ln())
+            colour::diverging(self.inc.log_ratio(s) / ln_ratio)
         } else {
             MASKED
         };
@@ -123,11 +123,13 @@ impl<'a> MapChart<'a> {
     /// One colour per sample, looked up per pixel (made once).
     fn colours(&self) -> &[[u8; 3]] {
         self.colours.get_or_init(|| {
+            // Once, not per sample (a libm call).
+            let ln_ratio = self.ratio.ln();
             self.inc
                 .samples
                 .par_iter()
                 .with_min_len(4096)
-                .map(|s| self.colour_of(s))
+                .map(|s| self.colour_of(s, ln_ratio))
                 .collect()
         })
     }
