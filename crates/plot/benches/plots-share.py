@@ -3,7 +3,9 @@
 `brtf fit golden_paper.txt --model metal --gray` with and without
 `--no-plots`, interleaved, for every binary given, and prints the medians of
 wall time and CPU time (user + sys of the child) and of their per-round
-differences. A script, not a test.
+differences, and the difference of the minima (on a loaded machine the
+medians drift with the other load; the fastest runs are the least
+disturbed ones). A script, not a test.
 
     python3 crates/plot/benches/plots-share.py ROUNDS BIN [BIN ...]
 """
@@ -53,7 +55,12 @@ def main():
               f"{med(c for _, c in full):.1f} ms CPU; --no-plots {med(w for w, _ in lean):.1f} ms wall, "
               f"{med(c for _, c in lean):.1f} ms CPU; plots' share (median of per-round differences) "
               f"{med(f[0] - l[0] for f, l in zip(full, lean)):.1f} ms wall, "
-              f"{med(f[1] - l[1] for f, l in zip(full, lean)):.1f} ms CPU")
+              f"{med(f[1] - l[1] for f, l in zip(full, lean)):.1f} ms CPU; "
+              f"minima (for a loaded machine: each the least disturbed run) with plots "
+              f"{min(w for w, _ in full):.1f} ms wall, {min(c for _, c in full):.1f} ms CPU, "
+              f"--no-plots {min(w for w, _ in lean):.1f} ms wall, {min(c for _, c in lean):.1f} ms CPU, "
+              f"difference {min(w for w, _ in full) - min(w for w, _ in lean):.1f} ms wall, "
+              f"{min(c for _, c in full) - min(c for _, c in lean):.1f} ms CPU")
 
 
 if __name__ == "__main__":
