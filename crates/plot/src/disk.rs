@@ -130,26 +130,29 @@ impl Buckets {
             let row = (floor((RADIUS - y) / cell)).clamp(0, last) as usize;
             row * size + column
         };
-        let index: Vec<u32> = points
-            .par_iter()
-            .with_min_len(8192)
-            .map(|p| bucket(p) as u32)
-            .collect();
+        // A counting sort, the bucket of a point found twice rather than
+        // kept (fewer fresh pages: on a 127k-point scan the page faults of
+        // these vectors cost more than the arithmetic).
         let mut start = vec![0u32; size * size + 1];
-        for &i in &index {
-            start[i as usize + 1] += 1;
+        for p in points {
+            start[bucket(p)] += 1;
         }
-        for i in 0..size * size {
-            start[i + 1] += start[i];
+        // Then `start[c]` is the end of bucket c; the points are placed
+        // from the last, each bucket filled from its end, which leaves
+        // `start[c]` at the bucket's beginning and keeps every bucket in
+        // index order.
+        for i in 1..size * size {
+            start[i] += start[i - 1];
         }
-        let mut fill = start.clone();
+        start[size * size] = points.len() as u32;
         let mut items = vec![0u32; points.len()];
         let mut sorted = vec![(0.0, 0.0); points.len()];
-        for (p, &i) in index.iter().enumerate() {
-            let at = fill[i as usize] as usize;
+        for (p, point) in points.iter().enumerate().rev() {
+            let c = bucket(point);
+            start[c] -= 1;
+            let at = start[c] as usize;
             items[at] = p as u32;
-            sorted[at] = points[p];
-            fill[i as usize] += 1;
+            sorted[at] = *point;
         }
         Buckets {
             size,
