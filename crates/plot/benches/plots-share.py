@@ -40,7 +40,13 @@ def main():
         sys.exit(__doc__)
     rounds, binaries = int(sys.argv[1]), sys.argv[2:]
     data = os.path.normpath(DATA)
-    out = tempfile.mkdtemp(prefix="plots-share-")
+    with tempfile.TemporaryDirectory(prefix="plots-share-") as out:
+        times = measure(binaries, rounds, data, out)
+    report(binaries, rounds, times)
+
+
+def measure(binaries, rounds, data, out):
+    """Wall and CPU times of every run, by (binary, lean)."""
     times = {}
     for _ in range(rounds):
         for b in binaries:
@@ -48,6 +54,11 @@ def main():
                 args = ["fit", data, "--model", "metal", "--gray", "--out",
                         os.path.join(out, "lean" if lean else "full"), "--force"]
                 times.setdefault((b, lean), []).append(run(b, args + ["--no-plots"] * lean))
+    return times
+
+
+def report(binaries, rounds, times):
+    """Prints the medians and minima of every binary."""
     med = statistics.median
     for b in binaries:
         full, lean = times[(b, False)], times[(b, True)]
