@@ -33,7 +33,7 @@ const START_SAMPLES_PER_INCIDENCE: usize = 16;
 /// The brightest samples every subsample keeps, whatever its stride.
 const BRIGHT_SAMPLES: usize = 250;
 /// Samples of the polish of the best start before the fit on every
-/// sample: from its optimum, the full fit converges in three steps.
+/// sample, which then needs a few passes.
 const POLISH_SAMPLES: usize = 2000;
 /// Multi-start ends polished and compared on every sample.
 const CANDIDATES: usize = 3;

@@ -50,9 +50,10 @@ impl Stage {
         tolerance: 1e-3,
         ..Stage::START
     };
-    /// The fit on every sample. From the polished start it takes three
-    /// steps; the gradient test stops it after the third, where ftol alone
-    /// would spend a fourth pass confirming a zero reduction.
+    /// The fit on every sample, with the secant term in its Hessian
+    /// (golden_paper: 6 passes from the polished start, 7 for the log
+    /// fit); the gradient test stops it where ftol alone would spend a
+    /// pass confirming a zero reduction.
     pub(crate) const FINAL: Stage = Stage {
         tolerance: 1e-12,
         gtol: 1e-6,
