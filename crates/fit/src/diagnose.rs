@@ -137,14 +137,19 @@ fn fitted_model(prepared: &PreparedMeasurement, data: &IncidenceData, bsdf: &Bsd
         .samples
         .par_chunks(MODEL_PIECE)
         .map(|piece| {
-            let lights = Directions::from_vectors(&vec![light; piece.len()]);
-            let mut views = Directions::with_capacity(piece.len());
+            let n = piece.len();
+            let lights = Directions {
+                x: vec![light.x; n],
+                y: vec![light.y; n],
+                z: vec![light.z; n],
+            };
+            let mut views = Directions::with_capacity(n);
             for s in piece {
                 views.push(s.view);
             }
             let mut values = RgbBatch::default();
             bsdf.eval_batch(&lights, &views, &mut values);
-            (0..piece.len())
+            (0..n)
                 .map(|i| luminance([values.r[i], values.g[i], values.b[i]], channels))
                 .collect()
         })

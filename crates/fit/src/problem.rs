@@ -908,7 +908,7 @@ impl Secant {
             .is_none_or(|(_, _, best)| squares < *best);
         if !lower {
             // A rejected trial: LM returns to the last point and its model.
-            return self.model(&gauss_newton, &gradient, squares, n);
+            return self.model(&gauss_newton, &gradient, squares);
         }
         if let Some((u_last, g_last, _)) = &self.last {
             let s = u - u_last;
@@ -917,14 +917,16 @@ impl Secant {
             self.update(&s, &y, &y_sharp);
         }
         self.last = Some((u.clone(), gradient.clone(), squares));
-        self.model(&gauss_newton, &gradient, squares, n)
+        self.model(&gauss_newton, &gradient, squares)
     }
 
     /// The Dennis-Gay-Welsch update of `S` for step `s`, gradient change
     /// `y` and its part `y♯ = y − JᵀJ s` that Gauss-Newton misses.
     fn update(&mut self, s: &DVector<f64>, y: &DVector<f64>, y_sharp: &DVector<f64>) {
+        // Only a step along which the gradient grows carries curvature.
         let ys = y.dot(s);
-        if !(ys.is_finite() && ys.abs() > 1e-12 * y.norm() * s.norm()) || ys <= 0.0 {
+        let informative = ys.is_finite() && ys > 1e-12 * y.norm() * s.norm();
+        if !informative {
             return;
         }
         let n = s.len();
@@ -939,11 +941,8 @@ impl Secant {
         let ws = w.dot(s);
         let updated = &estimate + (&w * y.transpose() + y * w.transpose()) / ys
             - (y * y.transpose()) * (ws / (ys * ys));
-        if updated.iter().all(|v| v.is_finite()) {
-            self.estimate = Some(updated);
-        } else {
-            self.estimate = Some(estimate);
-        }
+        let finite = updated.iter().all(|v| v.is_finite());
+        self.estimate = Some(if finite { updated } else { estimate });
     }
 
     /// `(z̃, ρ̃)` and `[R̃; 0]` with `R̃ᵀR̃ = JᵀJ + S`, `R̃ᵀz̃ = Jᵀr` and
@@ -953,9 +952,9 @@ impl Secant {
         gauss_newton: &DMatrix<f64>,
         gradient: &DVector<f64>,
         squares: f64,
-        n: usize,
     ) -> Option<(DVector<f64>, DMatrix<f64>)> {
         let estimate = self.estimate.as_ref()?;
+        let n = gradient.len();
         if (0..n).any(|k| gauss_newton[(k, k)] <= 0.0) {
             return None;
         }

@@ -262,7 +262,7 @@ pub(crate) fn grids_of_prepared(prepared: &PreparedMeasurement) -> [Option<Cover
     let m = &prepared.measurement;
     let channels = prepared.channels();
     let n = m.samples.len();
-    if prepared.removed_by.len() != n {
+    if prepared.removed_by.len() != n || prepared.directions.len() != n {
         // Not data `build` accepts as it is: the grids are made from the
         // built incidence instead.
         return [None, None];
@@ -283,7 +283,7 @@ pub(crate) fn grids_of_prepared(prepared: &PreparedMeasurement) -> [Option<Cover
             let s = &m.samples[k];
             (
                 s.theta_deg,
-                s.direction(),
+                prepared.directions[k],
                 prepared.removed_by[k].is_none(),
                 channel_mean(&s.values, channels),
             )
@@ -450,12 +450,10 @@ fn build(
         .par_chunks_mut(BLOCK)
         .zip(m.samples.par_chunks(BLOCK))
         .zip(removed_by.par_chunks(BLOCK))
+        .zip(prepared.directions.par_chunks(BLOCK))
         .enumerate()
-        .map(|(b, ((out, block), removed))| {
-            // The block's directions (not a vector of all of them: less
-            // fresh memory to fault in).
-            let dirs: Vec<DVec3> = block.iter().map(|s| s.direction()).collect();
-            let dirs = &dirs[..];
+        .map(|(b, (((out, block), removed), dirs))| {
+            // The block's directions, made once by the recipe.
             // Patch-averaged (Klems) data are compared with the averaged
             // model ([`PreparedMeasurement::model_value`]); else the model
             // is the BSDF at each direction, evaluated for the whole block
