@@ -264,7 +264,7 @@ impl Sample {
 
     /// |cos θ_out|.
     pub fn abs_cos_theta(&self) -> f64 {
-        self.theta_deg.to_radians().cos().abs()
+        brtf_model::cos_degrees(self.theta_deg).abs()
     }
 
     /// Which hemisphere the sample lies in.
@@ -281,10 +281,11 @@ impl Sample {
 }
 
 /// Unit vector `(sinθ cosφ, sinθ sinφ, cosθ)` for angles in degrees.
+///
+/// The same vector as [`brtf_model::direction`] (sines and cosines of the
+/// degrees reduced exactly, see [`brtf_model::sin_cos_degrees`]).
 pub fn direction_from_degrees(theta_deg: f64, phi_deg: f64) -> DVec3 {
-    let (st, ct) = theta_deg.to_radians().sin_cos();
-    let (sp, cp) = phi_deg.to_radians().sin_cos();
-    DVec3::new(st * cp, st * sp, ct)
+    brtf_model::direction(theta_deg, phi_deg)
 }
 
 /// Normalises an azimuth in degrees to `[0, 360)`.

@@ -152,7 +152,7 @@ impl Gate {
             Gate::Hemisphere { keep } => sample.hemisphere() == keep,
             Gate::ThetaCap { max_deg } => sample.theta_deg.min(180.0 - sample.theta_deg) <= max_deg,
             Gate::BeamMask { half_angle_deg } => {
-                direction().dot(context.light) < half_angle_deg.to_radians().cos()
+                direction().dot(context.light) < brtf_model::cos_degrees(half_angle_deg)
             }
             Gate::MinValue { min } => values.iter().all(|&v| v.is_finite() && v >= min),
             Gate::AzimuthBand {
@@ -160,7 +160,13 @@ impl Gate {
                 half_width_deg,
                 min_theta_deg,
             } => {
-                let dphi = (sample.phi_deg - center_deg).rem_euclid(360.0);
+                let dphi = sample.phi_deg - center_deg;
+                // rem_euclid is a slow fmod; in range it is the identity.
+                let dphi = if (0.0..360.0).contains(&dphi) {
+                    dphi
+                } else {
+                    dphi.rem_euclid(360.0)
+                };
                 let dphi = dphi.min(360.0 - dphi);
                 let theta = sample.theta_deg.min(180.0 - sample.theta_deg);
                 !(dphi <= half_width_deg && theta >= min_theta_deg)

@@ -34,6 +34,7 @@ mod batch;
 mod batch_gradient;
 mod bsdf;
 pub mod colour;
+mod degrees;
 mod kind;
 mod material;
 mod options;
@@ -43,6 +44,7 @@ pub use albedo::{Albedo, albedo, gauss_legendre_rule};
 pub use batch::{Directions, RgbBatch, exp_lane};
 pub use batch_gradient::{GeometryBatch, PairTerms};
 pub use bsdf::{Bsdf, Geometry, Gradient, Rgb, ViewSplit};
+pub use degrees::{cos_degrees, sin_cos_degrees};
 pub use kind::{MaterialKind, Variant};
 pub use material::{FTINY, MAX_ARGS, Material, ModelError, check_args};
 pub use options::{
@@ -55,8 +57,8 @@ use glam::DVec3;
 /// Unit vector for polar angle `theta_deg` (from the front normal) and
 /// azimuth `phi_deg`, both in degrees: `(sinθ cosφ, sinθ sinφ, cosθ)`.
 pub fn direction(theta_deg: f64, phi_deg: f64) -> DVec3 {
-    let (st, ct) = theta_deg.to_radians().sin_cos();
-    let (sp, cp) = phi_deg.to_radians().sin_cos();
+    let (st, ct) = sin_cos_degrees(theta_deg);
+    let (sp, cp) = sin_cos_degrees(phi_deg);
     DVec3::new(st * cp, st * sp, ct)
 }
 

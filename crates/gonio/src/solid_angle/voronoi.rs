@@ -95,14 +95,27 @@ pub(crate) fn hemisphere_areas(
 
 /// Lambert azimuthal equal-area projection of a direction about the normal
 /// of `hemisphere`, rounded to the grid.
+///
+/// With d = (x, y, z) the unit direction and θ' its angle from the normal,
+/// the projected radius is 2 sin(θ'/2) = sin θ' · √(2 / (1 + cos θ')), so
+/// the point is (x, y) · √(2 / (1 ± z)): no trigonometry beyond the
+/// direction's own.
 pub fn project(theta_deg: f64, phi_deg: f64, hemisphere: Hemisphere) -> [f64; 2] {
-    let from_normal = match hemisphere {
-        Hemisphere::Front => theta_deg,
-        Hemisphere::Back => 180.0 - theta_deg,
+    let d = brtf_model::direction(theta_deg, phi_deg);
+    let cos_from_normal = match hemisphere {
+        Hemisphere::Front => d.z,
+        Hemisphere::Back => -d.z,
     };
-    let r = 2.0 * (from_normal.to_radians() / 2.0).sin();
-    let (sp, cp) = phi_deg.to_radians().sin_cos();
-    [snap(r * cp), snap(r * sp)]
+    if cos_from_normal <= -0.5 {
+        // Far into the other hemisphere (never a member of this one): the
+        // radius from the half angle, which stays exact at the far pole.
+        let from_normal = cos_from_normal.acos();
+        let r = 2.0 * (from_normal / 2.0).sin();
+        let (sp, cp) = brtf_model::sin_cos_degrees(phi_deg);
+        return [snap(r * cp), snap(r * sp)];
+    }
+    let scale = (2.0 / (1.0 + cos_from_normal)).sqrt();
+    [snap(d.x * scale), snap(d.y * scale)]
 }
 
 fn snap(v: f64) -> f64 {
