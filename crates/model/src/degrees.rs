@@ -51,7 +51,7 @@ const REDUCIBLE: f64 = 1e14;
 /// infinite `x` gives NaNs, as libm does.
 #[inline]
 pub fn sin_cos_degrees(x: f64) -> (f64, f64) {
-    if !(x.abs() < REDUCIBLE) {
+    if x.abs() >= REDUCIBLE || x.is_nan() {
         return x.to_radians().sin_cos();
     }
     // The nearest quarter turn q: its low two bits are the quadrant.
