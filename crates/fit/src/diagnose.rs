@@ -211,7 +211,11 @@ pub(crate) fn diagnose(
         || model_albedo(prepared, &bsdf),
         || fitted_model(prepared, data, &bsdf),
     );
-    let measured = measured_sums(prepared, data, &model, scale);
+    // Two independent passes over the fitted samples, side by side.
+    let (measured, peak_offset_deg) = rayon::join(
+        || measured_sums(prepared, data, &model, scale),
+        || peak_offset(prepared, data, &model),
+    );
     // Data's reflectance: measured part ÷ scale, plus the model's rest.
     let complete = |part: Option<(f64, f64)>, model_total: f64| {
         part.map(|(data, model)| model_total + (data - model) / scale)
@@ -221,7 +225,7 @@ pub(crate) fn diagnose(
         rho_model,
         tau_data: complete(measured.back, tau_model),
         tau_model,
-        peak_offset_deg: peak_offset(prepared, data, &model),
+        peak_offset_deg,
         residual_check: None,
     })
 }
