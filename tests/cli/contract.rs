@@ -247,6 +247,11 @@ fn a_parameter_at_a_bound_breaks_no_command() {
         report.contains("at bound"),
         "report.html does not say `at bound`"
     );
+    // fit.json is written after the report, which still links it.
+    assert!(
+        report.contains("href=\"fit.json\"") && report.contains("href=\"params.csv\""),
+        "report.html of `brtf fit` does not link fit.json and params.csv"
+    );
     brtf(&["plot", s(&out)], "").ok();
     brtf(&["export", s(&out)], "").ok();
     brtf(&["check", s(&out), "--samples", "4"], "").ok();

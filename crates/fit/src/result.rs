@@ -252,28 +252,47 @@ impl FitResult {
         Ok(())
     }
 
-    /// Writes `DIR/fit.json` and `DIR/params.csv`, each atomically.
+    /// Writes `DIR/fit.json` and `DIR/params.csv`, each atomically;
+    /// nothing when the JSON would not read back.
     pub fn write(&self, dir: &Path) -> Result<(), brtf_io::IoError> {
+        let json = self.checked_json(dir)?;
+        self.write_params_csv(dir)?;
+        brtf_io::write_atomic(&dir.join("fit.json"), json.as_bytes())
+    }
+
+    /// Writes `DIR/params.csv` atomically (for a caller that writes
+    /// `fit.json` last, with [`FitResult::write_fit_json`]).
+    pub fn write_params_csv(&self, dir: &Path) -> Result<(), brtf_io::IoError> {
         let csv = self.params_csv().map_err(|e| brtf_io::IoError {
             path: dir.join("params.csv"),
             what: "cannot format",
             source: std::io::Error::other(e),
         })?;
+        brtf_io::ensure_folder(dir)?;
+        brtf_io::write_atomic(&dir.join("params.csv"), csv.as_bytes())
+    }
+
+    /// Writes `DIR/fit.json` atomically, unless it would not read back.
+    pub fn write_fit_json(&self, dir: &Path) -> Result<(), brtf_io::IoError> {
+        let json = self.checked_json(dir)?;
+        brtf_io::ensure_folder(dir)?;
+        brtf_io::write_atomic(&dir.join("fit.json"), json.as_bytes())
+    }
+
+    /// The `fit.json` text, checked to read back: JSON has no NaN or
+    /// infinity (serde_json writes null), so a non-finite number would
+    /// leave a folder no other command can read. Refused here instead.
+    fn checked_json(&self, dir: &Path) -> Result<String, brtf_io::IoError> {
         let json = self.to_json();
-        // What is written must read back: JSON has no NaN or infinity
-        // (serde_json writes null), so a non-finite number would leave a
-        // folder no other command can read. Refuse it here instead.
         let path = dir.join("fit.json");
-        if let Err(e) = FitResult::from_json(&json, &path) {
-            return Err(brtf_io::IoError {
+        match FitResult::from_json(&json, &path) {
+            Ok(_) => Ok(json),
+            Err(e) => Err(brtf_io::IoError {
                 path,
                 what: "refusing to write a fit.json that does not read back",
                 source: std::io::Error::other(e.to_string()),
-            });
+            }),
         }
-        brtf_io::ensure_folder(dir)?;
-        brtf_io::write_atomic(&dir.join("params.csv"), csv.as_bytes())?;
-        brtf_io::write_atomic(&path, json.as_bytes())
     }
 
     /// The `fit.json` text.

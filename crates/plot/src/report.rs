@@ -299,15 +299,21 @@ fn provenance_section(out: &mut String, dir: &Path, result: &FitResult) {
             .collect::<Vec<_>>()
             .join("; "))
     );
-    let mut links = Vec::new();
-    for f in ["fit.json", "params.csv"] {
-        if dir.join(f).is_file() {
-            links.push(format!("<a href=\"{}\">{}</a>", href(f), esc(f)));
-        }
+    // fit.json is always linked: every fit folder has one, and `brtf
+    // fit` writes it last, after this report (it lists the report).
+    let mut links = vec![format!(
+        "<a href=\"{}\">{}</a>",
+        href("fit.json"),
+        esc("fit.json")
+    )];
+    if dir.join("params.csv").is_file() {
+        links.push(format!(
+            "<a href=\"{}\">{}</a>",
+            href("params.csv"),
+            esc("params.csv")
+        ));
     }
-    if !links.is_empty() {
-        let _ = writeln!(out, "<p>Machine-readable: {}.</p>", links.join(" · "));
-    }
+    let _ = writeln!(out, "<p>Machine-readable: {}.</p>", links.join(" · "));
 }
 
 /// The page.

@@ -777,7 +777,8 @@ fn save_folder(
     brtf_io::check_replaceable(update.target(), inputs, force).map_err(io)?;
     let stage = update.path();
     let mut result = result.clone();
-    result.write(stage).map_err(io)?;
+    // fit.json is written once, last (below).
+    result.write_params_csv(stage).map_err(io)?;
     let mut outputs =
         describe_outputs(stage, &[stage.join("params.csv")], Producer::Fit).map_err(io)?;
     if export {
@@ -796,7 +797,7 @@ fn save_folder(
     outputs.sort_by(|a, b| a.path.cmp(&b.path));
     result.outputs = outputs;
     // fit.json last: it lists every other file of the folder.
-    result.write(stage).map_err(io)?;
+    result.write_fit_json(stage).map_err(io)?;
     let mut files: Vec<String> = result
         .outputs
         .iter()

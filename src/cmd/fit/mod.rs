@@ -125,7 +125,9 @@ fn write_fit_folder(
     notes: &mut Vec<String>,
 ) -> Result<String> {
     let context = || format!("writing the fit into {}", shown.display());
-    result.write(stage).with_context(context)?;
+    // fit.json is written once, last (below); the exports and plots take
+    // the result itself.
+    result.write_params_csv(stage).with_context(context)?;
     let mut outputs = describe_outputs(stage, &[stage.join("params.csv")], Producer::Fit)?;
     let mut lines = String::new();
     if !args.no_export {
@@ -160,7 +162,7 @@ fn write_fit_folder(
     outputs.sort_by(|a, b| a.path.cmp(&b.path));
     result.outputs = outputs;
     // fit.json last: it lists every other file of the folder.
-    result.write(stage).with_context(context)?;
+    result.write_fit_json(stage).with_context(context)?;
     Ok(lines)
 }
 
