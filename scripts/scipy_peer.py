@@ -15,10 +15,18 @@ optional Huber loss: scipy's own `loss="huber"`, `f_scale`) to the samples
 in FILE (`vx,vy,vz,y,w`), and prints scipy's cost at its own optimum and at
 brtf's parameters, as JSON. The CLI test `peer` uses it to check that
 brtf's cost is never above scipy's on the same objective.
+
+OpenBLAS runs on one thread here (unless OPENBLAS_NUM_THREADS is set):
+on the project's 2-core VM that fits the golden_paper samples in a median
+of 245 ms against 456 ms with its default two threads (9 alternating
+fits each, 2026-11-24), so the peer is measured at its faster setting.
 """
 import json
+import os
 import sys
 import time
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np
 from scipy.optimize import least_squares
