@@ -138,20 +138,14 @@ fn fitted_model(prepared: &PreparedMeasurement, data: &IncidenceData, bsdf: &Bsd
         .par_chunks(MODEL_PIECE)
         .map(|piece| {
             let n = piece.len();
-            let lights = Directions {
-                x: vec![light.x; n],
-                y: vec![light.y; n],
-                z: vec![light.z; n],
-            };
+            let lights = Directions::repeated(light, n);
             let mut views = Directions::with_capacity(n);
             for s in piece {
                 views.push(s.view);
             }
             let mut values = RgbBatch::default();
             bsdf.eval_batch(&lights, &views, &mut values);
-            (0..n)
-                .map(|i| luminance([values.r[i], values.g[i], values.b[i]], channels))
-                .collect()
+            (0..n).map(|i| luminance(values.get(i), channels)).collect()
         })
         .collect();
     pieces.concat()

@@ -139,7 +139,7 @@ impl Gate {
 
     /// [`Gate::keeps`] with the sample's direction from `direction`
     /// (called only by the gates that need it), for a caller that has the
-    /// directions already: each costs two `sin_cos`.
+    /// directions already.
     pub fn keeps_at(
         &self,
         sample: &Sample,

@@ -49,6 +49,15 @@ impl Directions {
         }
     }
 
+    /// `n` copies of `v` (one light for many views).
+    pub fn repeated(v: DVec3, n: usize) -> Directions {
+        Directions {
+            x: vec![v.x; n],
+            y: vec![v.y; n],
+            z: vec![v.z; n],
+        }
+    }
+
     /// The directions of `vectors`, in order.
     pub fn from_vectors(vectors: &[DVec3]) -> Directions {
         let mut d = Directions::with_capacity(vectors.len());

@@ -471,12 +471,7 @@ fn build(
                     }
                 }
                 None => {
-                    let n = block.len();
-                    let light = brtf_model::Directions {
-                        x: vec![incident.x; n],
-                        y: vec![incident.y; n],
-                        z: vec![incident.z; n],
-                    };
+                    let light = brtf_model::Directions::repeated(incident, block.len());
                     bsdf.eval_batch(
                         &light,
                         &brtf_model::Directions::from_vectors(dirs),

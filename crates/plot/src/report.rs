@@ -301,17 +301,10 @@ fn provenance_section(out: &mut String, dir: &Path, result: &FitResult) {
     );
     // fit.json is always linked: every fit folder has one, and `brtf
     // fit` writes it last, after this report (it lists the report).
-    let mut links = vec![format!(
-        "<a href=\"{}\">{}</a>",
-        href("fit.json"),
-        esc("fit.json")
-    )];
+    let link = |f: &str| format!("<a href=\"{}\">{}</a>", href(f), esc(f));
+    let mut links = vec![link("fit.json")];
     if dir.join("params.csv").is_file() {
-        links.push(format!(
-            "<a href=\"{}\">{}</a>",
-            href("params.csv"),
-            esc("params.csv")
-        ));
+        links.push(link("params.csv"));
     }
     let _ = writeln!(out, "<p>Machine-readable: {}.</p>", links.join(" · "));
 }
