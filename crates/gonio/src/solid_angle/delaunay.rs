@@ -179,43 +179,49 @@ fn triangulate_into(
     halfedges: &mut [u32],
 ) -> Option<()> {
     let len = 3 * triangle_count(corners, order.len());
-    if corners < 3
-        || points.len() < corners
-        || points.len() >= (NONE / 8) as usize
-        || triangles.len() != len
-        || halfedges.len() != len
-    {
+    if triangles.len() != len || halfedges.len() != len {
+        return None;
+    }
+    let mesh = triangulate_mesh(points, corners, order)?;
+    for (t, record) in mesh.iter().enumerate() {
+        triangles[3 * t..3 * t + 3].copy_from_slice(&record[..3]);
+        for k in 0..3 {
+            halfedges[3 * t + k] = flat_halfedge(record[4 + k], 0);
+        }
+    }
+    Some(())
+}
+
+/// A twin in the inserter's numbering (4t + k) as a halfedge of the flat
+/// layout (3t + k) numbered from `offset`, [`NONE`] kept.
+#[inline]
+fn flat_halfedge(twin: u32, offset: u32) -> u32 {
+    if twin == NONE {
+        NONE
+    } else {
+        3 * (twin >> 2) + (twin & 3) + offset
+    }
+}
+
+/// The triangulation of [`triangulate_in_polygon`] in the inserter's
+/// records (see [`Inserter`]): `triangle_count(corners, order.len())` of
+/// them, the polygon's fan first.
+fn triangulate_mesh(points: &[[f64; 2]], corners: usize, order: &[u32]) -> Option<Vec<[u32; 8]>> {
+    if corners < 3 || points.len() < corners || points.len() >= (NONE / 8) as usize {
         return None;
     }
     // Fan from corner 0: triangle k - 1 is (0, k, k + 1).
     let fan = corners as u32 - 2;
-    for k in 1..=fan {
-        let t = k - 1;
-        let base = 3 * t as usize;
-        triangles[base..base + 3].copy_from_slice(&[0, k, k + 1]);
-        let into_previous = if k == 1 { NONE } else { 3 * (t - 1) + 2 };
-        let into_next = if k == fan { NONE } else { 3 * (t + 1) };
-        halfedges[base..base + 3].copy_from_slice(&[into_previous, NONE, into_next]);
-    }
+    let mut mesh = Vec::with_capacity(triangle_count(corners, order.len()));
     let mut triangle_of = vec![NONE; points.len()];
     triangle_of[0] = 0;
     for k in 1..=fan {
-        triangle_of[k as usize] = k - 1;
-        triangle_of[k as usize + 1] = k - 1;
-    }
-    let mut mesh = Vec::with_capacity(len / 3);
-    for t in 0..fan as usize {
-        let mut record = [0; 8];
-        for k in 0..3 {
-            record[k] = triangles[3 * t + k];
-            let twin = halfedges[3 * t + k];
-            record[4 + k] = if twin == NONE {
-                NONE
-            } else {
-                4 * (twin / 3) + twin % 3
-            };
-        }
-        mesh.push(record);
+        let t = k - 1;
+        let into_previous = if k == 1 { NONE } else { 4 * (t - 1) + 2 };
+        let into_next = if k == fan { NONE } else { 4 * (t + 1) };
+        mesh.push([0, k, k + 1, 0, into_previous, NONE, into_next, 0]);
+        triangle_of[k as usize] = t;
+        triangle_of[k as usize + 1] = t;
     }
     let mut inserter = Inserter {
         points,
@@ -227,19 +233,7 @@ fn triangulate_into(
     for &p in order {
         inserter.insert(p)?;
     }
-    // Back to the flat layout, halfedge 3t + k.
-    for (t, record) in inserter.mesh.iter().enumerate() {
-        triangles[3 * t..3 * t + 3].copy_from_slice(&record[..3]);
-        for k in 0..3 {
-            let twin = record[4 + k];
-            halfedges[3 * t + k] = if twin == NONE {
-                NONE
-            } else {
-                3 * (twin >> 2) + (twin & 3)
-            };
-        }
-    }
-    Some(())
+    Some(inserter.mesh)
 }
 
 /// Below this many points (besides the corners) one thread triangulates
@@ -263,14 +257,15 @@ pub(crate) fn triangulate_spatially_ordered<V: EdgeVisitor>(
     corners: usize,
     halves: Option<(usize, f64)>,
     visitor: &V,
-) -> Option<(Triangulation, Vec<V::Sum>)> {
+) -> Option<Vec<V::Sum>> {
     let inner = points.len().saturating_sub(corners);
     if let Some((left, split)) = halves
         && inner >= SPLIT_MIN_POINTS
         && rayon::current_num_threads() >= 2
-        && let Some(result) = triangulate_in_polygon_split(points, corners, left, split, visitor)
+        && let Some((_, sums)) =
+            triangulate_in_polygon_split(points, corners, left, split, false, visitor)
     {
-        return Some(result);
+        return Some(sums);
     }
     let order: Vec<u32> = brio_order(inner)
         .into_iter()
@@ -285,33 +280,46 @@ pub(crate) fn triangulate_spatially_ordered<V: EdgeVisitor>(
             visitor.visit(&mut sum, tri.triangles[e], left, right);
         }
     }
-    Some((tri, vec![sum]))
+    Some(vec![sum])
 }
 
 /// What the merge needs from one half's Delaunay triangulation (made with
-/// the polygon's corners, in its share of the merged slots).
+/// the polygon's corners).
 struct Half {
     /// Kept triangles: their circumcircle lies strictly on the half's side
     /// of the split line, so no point of the other half is inside it and
-    /// the triangle is one of the whole set's Delaunay triangles. The
-    /// others are marked unused in the slots.
+    /// the triangle is one of the whole set's Delaunay triangles.
     kept: usize,
     /// The non-corner vertices of the triangles not kept.
     seam: Vec<u32>,
-    /// The halfedges (merged numbering) of kept triangles whose twin is a
-    /// triangle not kept: the edges between the kept part and the seam
-    /// region.
-    boundary: Vec<u32>,
-    /// The circumcentre of each boundary halfedge's (kept) triangle.
-    boundary_centres: Vec<[f64; 2]>,
+    /// The halfedges of kept triangles whose twin is a triangle not kept:
+    /// the edges between the kept part and the seam region.
+    boundary: Vec<BoundaryEdge>,
+    /// The half's triangulation in the flat layout, its halfedges numbered
+    /// from the half's offset and the triangles not kept marked unused:
+    /// only when the merged triangulation is asked for.
+    flat: Option<(Vec<u32>, Vec<u32>)>,
+}
+
+/// A halfedge `from` → `to` of a kept triangle (`from`, `to`, `apex`)
+/// whose twin lies in the seam region.
+struct BoundaryEdge {
+    /// Its number in the merged triangulation's flat layout.
+    merged: u32,
+    from: u32,
+    to: u32,
+    apex: u32,
+    /// The kept triangle's circumcentre.
+    centre: [f64; 2],
 }
 
 /// Triangulates the polygon's corners and `members` (one half's points,
-/// in spatial order) into `triangles` and `halfedges`,
-/// which start at halfedge `offset` of the merged numbering, and keeps
-/// the triangles whose vertices and circumcircle lie strictly left
-/// (`left`) or right of the line x = `split`, handing the edges between
-/// two kept triangles to `visitor`.
+/// in spatial order) and keeps the triangles whose vertices and
+/// circumcircle lie strictly left (`left`) or right of the line
+/// x = `split`, handing the edges between two kept triangles to
+/// `visitor`. The halfedges are numbered from `offset` in the merged
+/// flat layout; with `flat`, the half's triangles are also returned in
+/// that layout.
 #[allow(clippy::too_many_arguments)]
 fn triangulate_half<V: EdgeVisitor>(
     points: &[[f64; 2]],
@@ -319,9 +327,8 @@ fn triangulate_half<V: EdgeVisitor>(
     members: std::ops::Range<u32>,
     split: f64,
     left: bool,
-    triangles: &mut [u32],
-    halfedges: &mut [u32],
     offset: u32,
+    flat: bool,
     visitor: &V,
     sum: &mut V::Sum,
 ) -> Option<Half> {
@@ -338,12 +345,12 @@ fn triangulate_half<V: EdgeVisitor>(
         .into_iter()
         .map(|k| members.start + k)
         .collect();
-    triangulate_into(points, corners, &order, triangles, halfedges)?;
+    let mesh = triangulate_mesh(points, corners, &order)?;
     // The circumcentre of each kept triangle, NaN for the others.
-    let centres: Vec<[f64; 2]> = triangles
-        .chunks_exact(3)
-        .map(|t| {
-            let [a, b, c] = [t[0], t[1], t[2]].map(|i| points[i as usize]);
+    let centres: Vec<[f64; 2]> = mesh
+        .iter()
+        .map(|record| {
+            let [a, b, c] = [record[0], record[1], record[2]].map(|i| points[i as usize]);
             if !(beyond(a[0]) > 0.0 && beyond(b[0]) > 0.0 && beyond(c[0]) > 0.0) {
                 return [f64::NAN; 2];
             }
@@ -365,44 +372,55 @@ fn triangulate_half<V: EdgeVisitor>(
     let mut seen = vec![false; points.len()];
     let mut seam = Vec::new();
     let mut boundary = Vec::new();
-    let mut boundary_centres = Vec::new();
-    for t in 0..centres.len() {
-        let slots = 3 * t..3 * t + 3;
+    for (t, record) in mesh.iter().enumerate() {
         if is_kept(t) {
             kept += 1;
-            for e in slots {
-                let twin = halfedges[e] as usize;
-                if twin == NONE as usize {
+            for k in 0..3 {
+                let twin = record[4 + k];
+                if twin == NONE {
                     continue;
                 }
-                if !is_kept(twin / 3) {
-                    boundary.push(e as u32 + offset);
-                    boundary_centres.push(centres[t]);
+                let from = record[k];
+                if !is_kept((twin >> 2) as usize) {
+                    boundary.push(BoundaryEdge {
+                        merged: 3 * t as u32 + k as u32 + offset,
+                        from,
+                        to: record[(k + 1) % 3],
+                        apex: record[(k + 2) % 3],
+                        centre: centres[t],
+                    });
                 } else {
-                    visitor.visit(sum, triangles[e], centres[t], centres[twin / 3]);
+                    visitor.visit(sum, from, centres[t], centres[(twin >> 2) as usize]);
                 }
             }
         } else {
-            for v in &mut triangles[slots] {
-                let i = *v as usize;
+            for &v in &record[..3] {
+                let i = v as usize;
                 if i >= corners && !seen[i] {
                     seen[i] = true;
-                    seam.push(*v);
+                    seam.push(v);
                 }
-                *v = NONE;
             }
         }
     }
-    if offset != 0 {
-        for h in halfedges.iter_mut().filter(|h| **h != NONE) {
-            *h += offset;
+    let flat = flat.then(|| {
+        let mut triangles = Vec::with_capacity(3 * mesh.len());
+        let mut halfedges = Vec::with_capacity(3 * mesh.len());
+        for (t, record) in mesh.iter().enumerate() {
+            if is_kept(t) {
+                triangles.extend_from_slice(&record[..3]);
+            } else {
+                triangles.extend_from_slice(&[NONE; 3]);
+            }
+            halfedges.extend((0..3).map(|k| flat_halfedge(record[4 + k], offset)));
         }
-    }
+        (triangles, halfedges)
+    });
     Some(Half {
         kept,
         seam,
         boundary,
-        boundary_centres,
+        flat,
     })
 }
 
@@ -425,7 +443,7 @@ pub(crate) fn circumcentre(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> [f64; 2] {
 /// 1. The inner points come as two halves: the first `left_count` have
 ///    x < `split`, the others x ≥ `split`, each half in spatial order
 ///    (checked). Each half is triangulated with the polygon's corners, in
-///    parallel, straight into its share of the merged slots.
+///    parallel.
 /// 2. A triangle of one half whose vertices and circumcircle lie strictly
 ///    on its side is *kept*: no point of the other half can be in its
 ///    circle, so it is a Delaunay triangle of the whole set.
@@ -442,8 +460,11 @@ pub(crate) fn circumcentre(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> [f64; 2] {
 /// pieces tile the polygon), and every boundary edge passes the in-circle
 /// test with the triangles on both sides. With the edges inside each piece
 /// Delaunay by construction, the result is then locally Delaunay
-/// everywhere, hence a Delaunay triangulation of all the points. The
-/// halves' triangles not kept stay as unused slots ([`NONE`] vertices).
+/// everywhere, hence a Delaunay triangulation of all the points.
+///
+/// The triangulation itself is only made with `build` (the tests check
+/// it; the solid angles need only the visitor's sums): the halves' slots,
+/// those not kept unused ([`NONE`] vertices), then the seam's triangles.
 /// The visitor gets the halfedges of the kept triangles from the halves'
 /// threads (accumulators 0 and 1) and those of the seam's triangles from
 /// this one (into accumulator 0); its sums are only returned with a
@@ -453,8 +474,9 @@ pub(crate) fn triangulate_in_polygon_split<V: EdgeVisitor>(
     corners: usize,
     left_count: usize,
     split: f64,
+    build: bool,
     visitor: &V,
-) -> Option<(Triangulation, Vec<V::Sum>)> {
+) -> Option<(Option<Triangulation>, Vec<V::Sum>)> {
     if corners < 3 || points.len() < corners + 2 || points.len() >= (NONE / 8) as usize {
         return None;
     }
@@ -465,38 +487,26 @@ pub(crate) fn triangulate_in_polygon_split<V: EdgeVisitor>(
     let left = corners as u32..(corners + left_count) as u32;
     let right = left.end..points.len() as u32;
 
-    // One allocation for everything: half a's slots, half b's, then room
-    // for the seam's triangles (at most all of them). The zeroed pages are
-    // only touched by the thread that fills them.
+    // The merged numbering: half a's slots, half b's, then the seam's.
     let slots_a = 3 * triangle_count(corners, left.len());
     let slots_b = 3 * triangle_count(corners, right.len());
-    let slots_all = 3 * triangle_count(corners, points.len() - corners);
-    let mut triangles = vec![0u32; slots_a + slots_b + slots_all];
-    let mut halfedges = vec![0u32; slots_a + slots_b + slots_all];
-    triangles.truncate(slots_a + slots_b);
-    halfedges.truncate(slots_a + slots_b);
-    let ((a, mut sum_a), (b, sum_b)) = {
-        let (triangles_a, triangles_b) = triangles.split_at_mut(slots_a);
-        let (halfedges_a, halfedges_b) = halfedges.split_at_mut(slots_a);
-        rayon::join(
-            || {
-                let mut sum = visitor.start();
-                let (t, h) = (triangles_a, halfedges_a);
-                let half = triangulate_half(
-                    points, corners, left, split, true, t, h, 0, visitor, &mut sum,
-                );
-                (half, sum)
-            },
-            || {
-                let mut sum = visitor.start();
-                let (t, h, offset) = (triangles_b, halfedges_b, slots_a as u32);
-                let half = triangulate_half(
-                    points, corners, right, split, false, t, h, offset, visitor, &mut sum,
-                );
-                (half, sum)
-            },
-        )
-    };
+    let ((a, mut sum_a), (b, sum_b)) = rayon::join(
+        || {
+            let mut sum = visitor.start();
+            let half = triangulate_half(
+                points, corners, left, split, true, 0, build, visitor, &mut sum,
+            );
+            (half, sum)
+        },
+        || {
+            let mut sum = visitor.start();
+            let offset = slots_a as u32;
+            let half = triangulate_half(
+                points, corners, right, split, false, offset, build, visitor, &mut sum,
+            );
+            (half, sum)
+        },
+    );
     let (a, b) = (a?, b?);
 
     // The seam region's triangulation (its vertices in spatial order).
@@ -557,18 +567,15 @@ pub(crate) fn triangulate_in_polygon_split<V: EdgeVisitor>(
     let mut partner = vec![NONE; gap.triangles.len()];
     let mut paired = Vec::with_capacity(a.boundary.len() + b.boundary.len());
     let pt = |i: u32| points[i as usize];
-    for &e in a.boundary.iter().chain(&b.boundary) {
-        let u = triangles[e as usize];
-        let v = triangles[next(e) as usize];
-        let w = triangles[prev(e) as usize];
-        let g = find(v, u)?;
+    for edge in a.boundary.iter().chain(&b.boundary) {
+        let g = find(edge.to, edge.from)?;
         if partner[g as usize] != NONE {
             return None;
         }
-        partner[g as usize] = e;
+        partner[g as usize] = edge.merged;
         paired.push(g);
         let d = gap.triangles[prev(g) as usize];
-        if in_circle(pt(u), pt(v), pt(w), pt(d)) > 0.0 {
+        if in_circle(pt(edge.from), pt(edge.to), pt(edge.apex), pt(d)) > 0.0 {
             return None;
         }
     }
@@ -615,12 +622,10 @@ pub(crate) fn triangulate_in_polygon_split<V: EdgeVisitor>(
         })
         .collect();
     let centre_of = |g: u32| seam_centres[new_index[g as usize / 3] as usize];
-    let boundary_centres = a.boundary_centres.iter().chain(&b.boundary_centres);
-    let boundary = a.boundary.iter().chain(&b.boundary);
-    for ((&e, &kept), &g) in boundary.zip(boundary_centres).zip(&paired) {
+    for (edge, &g) in a.boundary.iter().chain(&b.boundary).zip(&paired) {
         let seam = centre_of(g);
-        visitor.visit(&mut sum_a, triangles[e as usize], kept, seam);
-        visitor.visit(&mut sum_a, gap.triangles[g as usize], seam, kept);
+        visitor.visit(&mut sum_a, edge.from, edge.centre, seam);
+        visitor.visit(&mut sum_a, edge.to, seam, edge.centre);
     }
     for &t in &inside {
         for g in 3 * t..3 * t + 3 {
@@ -631,8 +636,17 @@ pub(crate) fn triangulate_in_polygon_split<V: EdgeVisitor>(
             }
         }
     }
+    let sums = vec![sum_a, sum_b];
+    let (Some((mut triangles, mut halfedges)), Some((triangles_b, halfedges_b))) = (a.flat, b.flat)
+    else {
+        return Some((None, sums));
+    };
 
-    // Append the seam triangles and link them to the kept ones.
+    // The merged triangulation: the halves' slots, then the seam
+    // triangles, linked to the kept ones.
+    debug_assert_eq!((triangles.len(), triangles_b.len()), (slots_a, slots_b));
+    triangles.extend_from_slice(&triangles_b);
+    halfedges.extend_from_slice(&halfedges_b);
     let first = triangles.len() as u32;
     let merged = |g: u32| first + 3 * new_index[g as usize / 3] + g % 3;
     for &t in &inside {
@@ -655,11 +669,11 @@ pub(crate) fn triangulate_in_polygon_split<V: EdgeVisitor>(
         }
     }
     Some((
-        Triangulation {
+        Some(Triangulation {
             triangles,
             halfedges,
-        },
-        vec![sum_a, sum_b],
+        }),
+        sums,
     ))
 }
 
@@ -1075,8 +1089,9 @@ mod tests {
             .build()
             .unwrap();
         let (tri, counts) = pool
-            .install(|| triangulate_in_polygon_split(&points, 4, left, split, &Count))
+            .install(|| triangulate_in_polygon_split(&points, 4, left, split, true, &Count))
             .unwrap_or_else(|| panic!("{name}: the split triangulation gave up"));
+        let tri = tri.expect("built when asked for");
         check_delaunay(&points, 4, &tri);
         // The visitor saw each inner halfedge once: three per triangle,
         // less the polygon's four sides.

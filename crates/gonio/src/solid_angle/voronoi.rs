@@ -482,15 +482,14 @@ impl delaunay::EdgeVisitor for CellSums {
 /// triangulation's vertices (ghosts included), in a fixed order, or `None`
 /// if the triangulation gave up.
 fn cell_sums(vertices: &[[f64; 2]], halves: Option<(usize, f64)>) -> Option<Vec<Vec<f64>>> {
-    let (_, sums) = delaunay::triangulate_spatially_ordered(
+    delaunay::triangulate_spatially_ordered(
         vertices,
         GHOSTS,
         halves,
         &CellSums {
             vertices: vertices.len(),
         },
-    )?;
-    Some(sums)
+    )
 }
 
 /// Areas of the Voronoi cells of `points` clipped to the disk of radius
