@@ -139,8 +139,12 @@ impl Measurement {
                 }
             })
             .unzip();
+        let mut measurement = self.clone_without_samples();
+        measurement.quantity = quantity;
+        measurement.samples = samples;
+        measurement.mpc_columns = self.mpc_columns.clone();
         Converted {
-            measurement: self.with_samples(quantity, samples),
+            measurement,
             made_unavailable: unavailable.iter().filter(|&&u| u).count(),
         }
     }

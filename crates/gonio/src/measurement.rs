@@ -411,26 +411,6 @@ impl Measurement {
         }
     }
 
-    /// This measurement's description (everything but the samples) with
-    /// other `samples` of the same directions, holding `quantity`: the
-    /// samples are not copied first.
-    pub(crate) fn with_samples(&self, quantity: Quantity, samples: Vec<Sample>) -> Measurement {
-        debug_assert_eq!(samples.len(), self.samples.len());
-        Measurement {
-            format: self.format,
-            sample_name: self.sample_name.clone(),
-            incidence: self.incidence,
-            incidence_origin: self.incidence_origin,
-            up_phi_deg: self.up_phi_deg,
-            quantity,
-            channels: self.channels,
-            samples,
-            mpc_columns: self.mpc_columns.clone(),
-            beam: self.beam.clone(),
-            header: self.header.clone(),
-        }
-    }
-
     /// Number of samples.
     pub fn len(&self) -> usize {
         self.samples.len()
