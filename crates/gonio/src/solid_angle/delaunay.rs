@@ -16,8 +16,9 @@
 //! The walk tests each edge once (not the one it came in by) and the
 //! triangles are held during insertion as one 32-byte record each (three
 //! vertices and three twins), so a walk step or a flip reads one cache
-//! line per triangle; one thread's result is converted to the flat layout
-//! below.
+//! line per triangle. The cells are summed straight from these records;
+//! the flat layout below is made only for the seam's small triangulation
+//! and for the tests.
 //!
 //! With two threads the caller's two halves (points left and right of a
 //! vertical line, each in spatial order) are triangulated in parallel and
@@ -72,20 +73,6 @@ pub(crate) trait EdgeVisitor: Sync {
     fn start(&self) -> Self::Sum;
     /// Adds the halfedge from vertex `from` to `sum`.
     fn visit(&self, sum: &mut Self::Sum, from: u32, left: [f64; 2], right: [f64; 2]);
-}
-
-/// The circumcentre of each triangle of `triangles` (vertex triples).
-fn circumcentres(points: &[[f64; 2]], triangles: &[u32]) -> Vec<[f64; 2]> {
-    triangles
-        .chunks_exact(3)
-        .map(|t| {
-            circumcentre(
-                points[t[0] as usize],
-                points[t[1] as usize],
-                points[t[2] as usize],
-            )
-        })
-        .collect()
 }
 
 /// The halfedge after `e` in its triangle.
@@ -157,10 +144,13 @@ pub(crate) fn triangulate_in_polygon(
     corners: usize,
     order: &[u32],
 ) -> Option<Triangulation> {
-    let len = 3 * triangle_count(corners, order.len());
-    let mut triangles = vec![0; len];
-    let mut halfedges = vec![0; len];
-    triangulate_into(points, corners, order, &mut triangles, &mut halfedges)?;
+    let mesh = triangulate_mesh(points, corners, order)?;
+    let mut triangles = Vec::with_capacity(3 * mesh.len());
+    let mut halfedges = Vec::with_capacity(3 * mesh.len());
+    for record in &mesh {
+        triangles.extend_from_slice(&record[..3]);
+        halfedges.extend((0..3).map(|k| flat_halfedge(record[4 + k], 0)));
+    }
     Some(Triangulation {
         triangles,
         halfedges,
@@ -171,30 +161,6 @@ pub(crate) fn triangulate_in_polygon(
 /// `corners` corners (Euler's formula).
 fn triangle_count(corners: usize, inner: usize) -> usize {
     corners.saturating_sub(2) + 2 * inner
-}
-
-/// [`triangulate_in_polygon`] into the given slices, of exactly
-/// `3 * triangle_count(corners, order.len())` entries each; the halfedges
-/// are numbered from the start of the slices.
-fn triangulate_into(
-    points: &[[f64; 2]],
-    corners: usize,
-    order: &[u32],
-    triangles: &mut [u32],
-    halfedges: &mut [u32],
-) -> Option<()> {
-    let len = 3 * triangle_count(corners, order.len());
-    if triangles.len() != len || halfedges.len() != len {
-        return None;
-    }
-    let mesh = triangulate_mesh(points, corners, order)?;
-    for (t, record) in mesh.iter().enumerate() {
-        triangles[3 * t..3 * t + 3].copy_from_slice(&record[..3]);
-        for k in 0..3 {
-            halfedges[3 * t + k] = flat_halfedge(record[4 + k], 0);
-        }
-    }
-    Some(())
 }
 
 /// A twin in the inserter's numbering (4t + k) as a halfedge of the flat
@@ -276,13 +242,25 @@ pub(crate) fn triangulate_spatially_ordered<V: EdgeVisitor>(
         .into_iter()
         .map(|k| k + corners as u32)
         .collect();
-    let tri = triangulate_in_polygon(points, corners, &order)?;
-    let centres = circumcentres(points, &tri.triangles);
+    let mesh = triangulate_mesh(points, corners, &order)?;
+    let centres: Vec<[f64; 2]> = mesh
+        .iter()
+        .map(|r| {
+            circumcentre(
+                points[r[0] as usize],
+                points[r[1] as usize],
+                points[r[2] as usize],
+            )
+        })
+        .collect();
     let mut sum = visitor.start();
-    for (e, &twin) in tri.halfedges.iter().enumerate() {
-        if twin != NONE {
-            let (left, right) = (centres[e / 3], centres[twin as usize / 3]);
-            visitor.visit(&mut sum, tri.triangles[e], left, right);
+    for (t, record) in mesh.iter().enumerate() {
+        for k in 0..3 {
+            let twin = record[4 + k];
+            if twin != NONE {
+                let (left, right) = (centres[t], centres[(twin >> 2) as usize]);
+                visitor.visit(&mut sum, record[k], left, right);
+            }
         }
     }
     Some(vec![sum])
