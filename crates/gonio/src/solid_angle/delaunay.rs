@@ -145,12 +145,7 @@ pub(crate) fn triangulate_in_polygon(
     order: &[u32],
 ) -> Option<Triangulation> {
     let mesh = triangulate_mesh(points, corners, order)?;
-    let mut triangles = Vec::with_capacity(3 * mesh.len());
-    let mut halfedges = Vec::with_capacity(3 * mesh.len());
-    for record in &mesh {
-        triangles.extend_from_slice(&record[..3]);
-        halfedges.extend((0..3).map(|k| flat_halfedge(record[4 + k], 0)));
-    }
+    let (triangles, halfedges) = flat_layout(&mesh, 0, |_| true);
     Some(Triangulation {
         triangles,
         halfedges,
@@ -172,6 +167,36 @@ fn flat_halfedge(twin: u32, offset: u32) -> u32 {
     } else {
         3 * (twin >> 2) + (twin & 3) + offset
     }
+}
+
+/// The inserter's records in the flat layout (triangles and halfedges),
+/// halfedges numbered from `offset`; the triangles for which `kept` is
+/// false become unused slots ([`NONE`] vertices).
+fn flat_layout(
+    mesh: &[[u32; 8]],
+    offset: u32,
+    kept: impl Fn(usize) -> bool,
+) -> (Vec<u32>, Vec<u32>) {
+    let mut triangles = Vec::with_capacity(3 * mesh.len());
+    let mut halfedges = Vec::with_capacity(3 * mesh.len());
+    for (t, record) in mesh.iter().enumerate() {
+        if kept(t) {
+            triangles.extend_from_slice(&record[..3]);
+        } else {
+            triangles.extend_from_slice(&[NONE; 3]);
+        }
+        halfedges.extend((0..3).map(|k| flat_halfedge(record[4 + k], offset)));
+    }
+    (triangles, halfedges)
+}
+
+/// The circumcentre of an inserter record's triangle.
+fn record_centre(points: &[[f64; 2]], record: &[u32; 8]) -> [f64; 2] {
+    circumcentre(
+        points[record[0] as usize],
+        points[record[1] as usize],
+        points[record[2] as usize],
+    )
 }
 
 /// The triangulation of [`triangulate_in_polygon`] in the inserter's
@@ -243,16 +268,7 @@ pub(crate) fn triangulate_spatially_ordered<V: EdgeVisitor>(
         .map(|k| k + corners as u32)
         .collect();
     let mesh = triangulate_mesh(points, corners, &order)?;
-    let centres: Vec<[f64; 2]> = mesh
-        .iter()
-        .map(|r| {
-            circumcentre(
-                points[r[0] as usize],
-                points[r[1] as usize],
-                points[r[2] as usize],
-            )
-        })
-        .collect();
+    let centres: Vec<[f64; 2]> = mesh.iter().map(|r| record_centre(points, r)).collect();
     let mut sum = visitor.start();
     for (t, record) in mesh.iter().enumerate() {
         for k in 0..3 {
@@ -386,19 +402,7 @@ fn triangulate_half<V: EdgeVisitor>(
             }
         }
     }
-    let flat = flat.then(|| {
-        let mut triangles = Vec::with_capacity(3 * mesh.len());
-        let mut halfedges = Vec::with_capacity(3 * mesh.len());
-        for (t, record) in mesh.iter().enumerate() {
-            if is_kept(t) {
-                triangles.extend_from_slice(&record[..3]);
-            } else {
-                triangles.extend_from_slice(&[NONE; 3]);
-            }
-            halfedges.extend((0..3).map(|k| flat_halfedge(record[4 + k], offset)));
-        }
-        (triangles, halfedges)
-    });
+    let flat = flat.then(|| flat_layout(&mesh, offset, is_kept));
     Some(Half {
         kept,
         seam,
