@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # brtf's fitter against the scipy peer, measured side by side in one run.
 #
-# 1. Whole process (issue 18): `brtf fit golden_paper.txt --model metal
+# 1. Whole process: `brtf fit golden_paper.txt --model metal
 #    --gray`, once with `--no-plots --no-export` and once with every output,
 #    against scripts/scipy_peer.py's least_squares fit alone on the same
 #    122 278 samples brtf fits (written by the CLI test `speed` to

@@ -19,7 +19,7 @@ brtf's cost is never above scipy's on the same objective.
 OpenBLAS runs on one thread here (unless OPENBLAS_NUM_THREADS is set):
 on the project's 2-core VM that fits the golden_paper samples in a median
 of 245 ms against 456 ms with its default two threads (9 alternating
-fits each, 2026-11-24), so the peer is measured at its faster setting.
+fits each), so the peer is measured at its faster setting.
 """
 import json
 import os

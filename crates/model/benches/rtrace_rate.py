@@ -1,5 +1,5 @@
 """rtrace's BRDF evaluation rate on this machine: the anchor that the
-brtf-model `eval/*` benchmarks are compared with (issue 18).
+brtf-model `eval/*` benchmarks are compared with.
 
 One rtrace process per run traces N eye rays at the oracle scene
 (shared/oracle/rtrace_oracle.py, one polygon under a distant source);

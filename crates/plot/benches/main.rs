@@ -6,7 +6,7 @@
 //! * `plots/write_plots_with_data`: everything `brtf fit` adds for its
 //!   plots (the model beside every fitted sample, every SVG and PNG,
 //!   `report.html`), on the data the fit fitted, into a temporary folder.
-//!   The target of issue 18 is 40 ms.
+//!   The target is 40 ms.
 //! * `plots/write_plots`: the same as `brtf plot` does it, with the file
 //!   read again and rebuilt with the fit's recipe.
 //! * `plots/load`: only the rebuild of the data ([`brtf_plot::prepare::load`],

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The plots' share of a whole `brtf fit` run (issue 18): runs
+"""The plots' share of a whole `brtf fit` run: runs
 `brtf fit golden_paper.txt --model metal --gray` with and without
 `--no-plots`, interleaved, for every binary given, and prints the medians of
 wall time and CPU time (user + sys of the child) and of their per-round
