@@ -48,6 +48,8 @@ mod set;
 mod solve;
 mod summary;
 mod table;
+#[cfg(test)]
+mod tests;
 mod uncertainty;
 mod validate;
 
