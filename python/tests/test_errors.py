@@ -62,7 +62,7 @@ def test_wrong_model_name_and_options(alu):
         brtf.fit(alu, model="metl")
     assert "metl" in str(e.value) and "plastic, metal, trans" in str(e.value)
     assert isinstance(e.value, ValueError)
-    with pytest.raises(brtf.ModelError, match="unknown material type"):
+    with pytest.raises(brtf.ModelError, match="is not one of plastic, metal"):
         brtf.Material("shiny", rgb=0.5)
     with pytest.raises(brtf.ModelError, match="residual"):
         brtf.fit(alu, model="metal", residual="squared")

@@ -2,7 +2,7 @@
 //! ([`brtf_trace::check`]) and writes the comparison to `DIR/check.csv`.
 
 use super::output::write_atomic;
-use super::shared::{read_fit, with_jobs};
+use super::shared::with_jobs;
 use anyhow::Result;
 use brtf_trace::check::{CheckOptions, check_fit};
 use clap::Args;
@@ -62,7 +62,7 @@ pub fn run(args: CheckArgs) -> Result<()> {
         search_dirs: args.search_dirs.clone(),
     };
     options.validate()?;
-    let fit = read_fit(&args.dir)?;
+    let fit = brtf_workflow::read_fit(&args.dir)?;
     let report = with_jobs(args.jobs, || check_fit(&fit, &args.dir, &options))??;
     super::output::print(&report.to_string())?;
     let out = args

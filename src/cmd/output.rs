@@ -1,7 +1,7 @@
 //! Where results go. Files are written through [`brtf_io::write_atomic`]
-//! (a failed run leaves nothing half-written), output folders through
-//! [`brtf_io::FolderUpdate`], and text through [`Stdout`], whose errors
-//! say that standard output failed; `main` exits quietly on a closed pipe.
+//! (a failed run leaves nothing half-written), fit folders through
+//! brtf-workflow, and text through [`Stdout`], whose errors say that
+//! standard output failed; `main` exits quietly on a closed pipe.
 
 use anyhow::Result;
 use std::io::Write;
@@ -14,20 +14,6 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
         brtf_io::ensure_folder(folder)?;
     }
     Ok(brtf_io::write_atomic(path, bytes)?)
-}
-
-/// Lists `fresh`, the files `by` wrote into the staged folder `stage`, in
-/// its `fit.json`, and removes the files `by` listed there before and did
-/// not write again. A folder without `fit.json` keeps no listing.
-pub fn relist(stage: &Path, fresh: &[std::path::PathBuf], by: brtf_io::Producer) -> Result<()> {
-    let path = stage.join("fit.json");
-    if !path.exists() {
-        return Ok(());
-    }
-    let mut fit = brtf_fit::FitResult::read(&path)?;
-    let fresh = brtf_io::describe_outputs(stage, fresh, by)?;
-    fit.outputs = brtf_io::replace_outputs(stage, &fit.outputs, fresh, by)?;
-    Ok(brtf_io::write_atomic(&path, fit.to_json().as_bytes())?)
 }
 
 /// Standard output whose errors name it and keep their kind (so that

@@ -2,10 +2,8 @@
 //! `report.html` for a fit folder (what `brtf fit` also draws unless
 //! `--no-plots`).
 
-use super::output::{print, relist};
-use super::shared::read_fit;
-use anyhow::{Context, Result};
-use brtf_io::{FolderUpdate, Producer};
+use super::output::print;
+use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -39,20 +37,12 @@ pub fn run(args: PlotArgs) -> Result<()> {
         );
     }
     let started = Instant::now();
-    let mut options = brtf_plot::PlotOptions {
+    let options = brtf_plot::PlotOptions {
         search_dirs: args.search_dirs,
         ratio: args.ratio,
         plane_tolerance_deg: args.plane_tolerance,
     };
-    let result = read_fit(&args.dir)?;
-    // Into a copy of the folder, swapped in at the end: replaces the plots
-    // and the report, keeps the rest.
-    let update = FolderUpdate::amend(&args.dir)?;
-    options.search_dirs.push(args.dir.clone());
-    let written = brtf_plot::write_plots(update.path(), &result, &options)
-        .with_context(|| format!("cannot plot {}", args.dir.display()))?;
-    relist(update.path(), &written.files, Producer::Plot)?;
-    update.commit()?;
+    let written = brtf_workflow::plot_folder(&args.dir, options)?;
     for w in &written.warnings {
         say!("brtf: warning: {w}");
     }

@@ -1,13 +1,21 @@
-//! Helpers several subcommands share: reading a fit folder and running
-//! work on a chosen number of threads.
+//! Helpers several subcommands share: option words, worker threads and
+//! CSV output.
 
 use anyhow::{Context, Result};
-use brtf_fit::FitResult;
-use std::path::Path;
+use brtf_model::{OptionWords, WordError};
+use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 
-/// Reads `DIR/fit.json` (see [`FitResult::read`]).
-pub fn read_fit(dir: &Path) -> Result<FitResult> {
-    Ok(FitResult::read(&dir.join("fit.json"))?)
+/// clap's parser for a library enum's words ([`OptionWords`]): `--help`
+/// lists them, and older spellings are read as aliases.
+pub fn words<T>() -> impl TypedValueParser<Value = T>
+where
+    T: OptionWords + std::str::FromStr<Err = WordError> + Clone + Send + Sync,
+{
+    let values = T::WORDS.iter().zip(T::ALL).map(|(&word, choice)| {
+        let aliases = T::ALIASES.iter().filter(|(_, c)| c.word() == choice.word());
+        PossibleValue::new(word).aliases(aliases.map(|(alias, _)| *alias))
+    });
+    PossibleValuesParser::new(values.collect::<Vec<_>>()).try_map(|s| s.parse::<T>())
 }
 
 /// Runs `f` on a rayon pool of `jobs` threads (or the global pool).

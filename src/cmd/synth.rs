@@ -2,10 +2,11 @@
 
 use super::material::{FormulaArgs, MaterialArgs};
 use super::output::write_atomic;
+use super::shared::words;
 use anyhow::{Result, bail};
 use brtf_gonio::synth::{GroundTruth, Instrument, Layout, SYNTH_MARKER, SynthSet};
 use brtf_gonio::{Channels, SourceFormat};
-use clap::{Args, ValueEnum};
+use clap::Args;
 use std::path::PathBuf;
 
 #[derive(Args, Debug)]
@@ -30,9 +31,9 @@ pub struct SynthArgs {
     /// Incident azimuth φ_in in degrees.
     #[arg(long, default_value_t = 0.0)]
     pub phi_in: f64,
-    /// Output format.
-    #[arg(long, value_enum, default_value_t = FormatArg::Mpc)]
-    pub format: FormatArg,
+    /// Output format: mpc or mountain.
+    #[arg(long, value_parser = words::<SourceFormat>(), default_value_t = SourceFormat::Mpc)]
+    pub format: SourceFormat,
     /// Values per row: 1 (CIE-Y, the luminance) or 3 (CIE X, Y, Z; Mountain only).
     #[arg(long, default_value_t = 1)]
     pub channels: usize,
@@ -87,20 +88,13 @@ pub struct SynthModelArgs {
     pub formula: FormulaArgs,
 }
 
-#[derive(Clone, Copy, Debug, ValueEnum)]
-pub enum FormatArg {
-    Mpc,
-    Mountain,
-}
-
 pub fn run(args: SynthArgs) -> Result<()> {
     let truth = match (&args.material, &args.ggx) {
         (Some(path), None) => {
             let material = MaterialArgs {
                 material: path.clone(),
                 name: args.model.name.clone(),
-                variant: args.model.formula.variant,
-                fresnel_k: args.model.formula.fresnel_k,
+                formula: args.model.formula,
                 source_omega: 0.0,
                 curved: false,
             };
@@ -148,10 +142,7 @@ pub fn run(args: SynthArgs) -> Result<()> {
             3 => Channels::Xyz,
             n => bail!("--channels must be 1 or 3, not {n}"),
         },
-        format: match args.format {
-            FormatArg::Mpc => SourceFormat::Mpc,
-            FormatArg::Mountain => SourceFormat::Mountain,
-        },
+        format: args.format,
         seed: args.seed,
         prefix: args.prefix.clone().unwrap_or_else(|| {
             args.out
@@ -160,7 +151,7 @@ pub fn run(args: SynthArgs) -> Result<()> {
         }),
         header: vec![format!(
             "#command: {}",
-            std::env::args().collect::<Vec<_>>().join(" ")
+            super::fit::command_line().join(" ")
         )],
     };
     set.validate()?;

@@ -33,6 +33,12 @@ pub enum ResidualKind {
     Log,
 }
 
+brtf_model::option_words!(ResidualKind {
+    Absolute => "absolute",
+    Relative => "relative",
+    Log => "log",
+});
+
 /// The samples of one incidence, ready for the inner loop.
 #[derive(Debug, Clone)]
 pub(crate) struct Block<'a> {

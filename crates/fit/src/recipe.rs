@@ -61,12 +61,18 @@ pub enum ColourConversion {
     AsRecorded,
 }
 
-impl std::fmt::Display for ColourConversion {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
+brtf_model::option_words!(ColourConversion {
+    XyzToRadianceRgb => "xyz",
+    AsRecorded => "as-recorded",
+});
+
+impl ColourConversion {
+    /// What the conversion does, for people.
+    pub fn describe(self) -> &'static str {
+        match self {
             ColourConversion::XyzToRadianceRgb => "CIE XYZ converted to Radiance RGB",
             ColourConversion::AsRecorded => "three channels taken as Radiance RGB",
-        })
+        }
     }
 }
 
@@ -79,6 +85,8 @@ pub enum WeightRule {
     /// Every sample weighs 1.
     Uniform,
 }
+
+brtf_model::option_words!(WeightRule { SolidAngle => "solid-angle", Uniform => "uniform" });
 
 /// Everything that decides how a measurement file becomes fitted data.
 /// The residual kind, floor and loss are the fit's ([`crate::FitConfig`]).

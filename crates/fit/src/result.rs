@@ -174,6 +174,18 @@ pub enum ReadFitError {
     },
 }
 
+impl ReadFitError {
+    /// The file concerned.
+    pub fn path(&self) -> &Path {
+        match self {
+            ReadFitError::Io { path, .. }
+            | ReadFitError::Parse { path, .. }
+            | ReadFitError::Invalid { path, .. }
+            | ReadFitError::Schema { path, .. } => path,
+        }
+    }
+}
+
 impl FitResult {
     /// Reads `fit.json`, or `DIR/fit.json` when `path` is a folder,
     /// checking the schema version first.

@@ -21,6 +21,8 @@ pub trait Progress: Sync {
     fn advance(&self) {}
     /// All steps finished.
     fn end(&self) {}
+    /// What is being worked on now (`front side`, `12 samples`).
+    fn label(&self, _text: &str) {}
 }
 
 /// Reports nothing.

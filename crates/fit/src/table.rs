@@ -25,6 +25,8 @@ pub enum Interpolation {
     Linear,
 }
 
+brtf_model::option_words!(Interpolation { Pchip => "pchip", Linear => "linear" });
+
 /// Why a table could not be built.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]

@@ -57,8 +57,8 @@ pub use convert::{Converted, GRAZING_COS_LIMIT};
 pub use error::{ConvertError, KlemsProblem, ParseErrorKind, ReadError, WriteError};
 pub use integral::{HemisphereIntegral, hemispherical_integral};
 pub use measurement::{
-    BeamReference, Channels, Hemisphere, Incidence, IncidenceOrigin, Measurement, MpcColumns,
-    Quantity, SENTINEL, SENTINEL_TEXT, SENTINEL_THRESHOLD, Sample, SourceFormat,
+    BeamReference, Channels, Hemisphere, Hemispheres, Incidence, IncidenceOrigin, Measurement,
+    MpcColumns, Quantity, SENTINEL, SENTINEL_TEXT, SENTINEL_THRESHOLD, Sample, SourceFormat,
     direction_from_degrees, normalize_phi_deg,
 };
 pub use read::{

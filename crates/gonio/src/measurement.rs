@@ -45,13 +45,20 @@ pub enum SourceFormat {
     KlemsXml,
 }
 
-impl std::fmt::Display for SourceFormat {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
+brtf_model::option_words!(SourceFormat {
+    Mpc => "mpc",
+    Mountain => "mountain",
+    KlemsXml => "klems-xml",
+});
+
+impl SourceFormat {
+    /// The format's name, for people.
+    pub fn describe(self) -> &'static str {
+        match self {
             SourceFormat::Mpc => "ISE .mpc",
             SourceFormat::Mountain => "pab-opto Mountain",
             SourceFormat::KlemsXml => "Klems BSDF XML (patch averages)",
-        })
+        }
     }
 }
 
@@ -175,6 +182,10 @@ pub enum Channels {
     Xyz,
 }
 
+// `rgb`: `brtf render gonio --channels rgb` writes the material's colour
+// as CIE X, Y, Z.
+brtf_model::option_words!(Channels { Y => "y", Xyz => "xyz" | "rgb" });
+
 impl Channels {
     /// Number of values per sample (1 or 3).
     pub fn count(self) -> usize {
@@ -212,6 +223,30 @@ pub enum Hemisphere {
     Front,
     /// θ > 90°.
     Back,
+}
+
+/// Which hemispheres a fit uses: one, or both.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Hemispheres {
+    /// The front hemisphere (reflection).
+    Front,
+    /// The back hemisphere (transmission).
+    Back,
+    /// Both.
+    Both,
+}
+
+brtf_model::option_words!(Hemispheres { Front => "front", Back => "back", Both => "both" });
+
+impl Hemispheres {
+    /// The one hemisphere kept, or `None` for both.
+    pub fn only(self) -> Option<Hemisphere> {
+        match self {
+            Hemispheres::Front => Some(Hemisphere::Front),
+            Hemispheres::Back => Some(Hemisphere::Back),
+            Hemispheres::Both => None,
+        }
+    }
 }
 
 impl Hemisphere {

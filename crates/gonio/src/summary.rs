@@ -222,7 +222,7 @@ impl fmt::Display for Summary {
             IncidenceOrigin::FileName => "from the file name",
             IncidenceOrigin::Programmatic => "set by code",
         };
-        writeln!(f, "  format        {}", self.format)?;
+        writeln!(f, "  format        {}", self.format.describe())?;
         if let Some(name) = &self.sample_name {
             writeln!(f, "  sample        {name}")?;
         }

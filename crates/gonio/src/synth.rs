@@ -411,6 +411,13 @@ impl SynthSet {
                 allowed: "one line without / or \\ (it names files and the sample)",
             });
         }
+        if self.format == SourceFormat::KlemsXml {
+            return Err(OptionError {
+                option: "--format",
+                value: self.format.to_string(),
+                allowed: "mpc or mountain",
+            });
+        }
         if self.format == SourceFormat::Mpc && self.channels == Channels::Xyz {
             return Err(OptionError {
                 option: "--channels",

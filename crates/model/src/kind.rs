@@ -4,9 +4,6 @@
 //! name, how many real arguments it takes, their names (as used in the fit
 //! tables) and their physical bounds.
 
-use std::fmt;
-use std::str::FromStr;
-
 /// One of Radiance's six Ward-type material types.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum MaterialKind {
@@ -47,14 +44,7 @@ impl MaterialKind {
 
     /// The Radiance type name (`plastic`, `metal2`, ...).
     pub fn name(self) -> &'static str {
-        match self {
-            MaterialKind::Plastic => "plastic",
-            MaterialKind::Metal => "metal",
-            MaterialKind::Trans => "trans",
-            MaterialKind::Plastic2 => "plastic2",
-            MaterialKind::Metal2 => "metal2",
-            MaterialKind::Trans2 => "trans2",
-        }
+        crate::OptionWords::word(self)
     }
 
     /// Number of real arguments Radiance expects.
@@ -136,24 +126,14 @@ impl MaterialKind {
     }
 }
 
-impl fmt::Display for MaterialKind {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for MaterialKind {
-    type Err = String;
-
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        MaterialKind::ALL
-            .into_iter()
-            .find(|k| k.name() == s)
-            .ok_or_else(|| {
-                format!("unknown material type `{s}` (expected plastic, metal, trans, plastic2, metal2 or trans2)")
-            })
-    }
-}
+crate::option_words!(MaterialKind {
+    Plastic => "plastic",
+    Metal => "metal",
+    Trans => "trans",
+    Plastic2 => "plastic2",
+    Metal2 => "metal2",
+    Trans2 => "trans2",
+});
 
 /// Which formula set to evaluate.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -176,29 +156,12 @@ impl Variant {
 
     /// Name used on the command line and in output files.
     pub fn name(self) -> &'static str {
-        match self {
-            Variant::Radiance => "radiance",
-            Variant::Manual2004 => "manual2004",
-            Variant::Ward1992 => "ward1992",
-        }
+        crate::OptionWords::word(self)
     }
 }
 
-impl fmt::Display for Variant {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for Variant {
-    type Err = String;
-
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Variant::ALL
-            .into_iter()
-            .find(|v| v.name() == s)
-            .ok_or_else(|| {
-                format!("unknown variant `{s}` (expected radiance, manual2004 or ward1992)")
-            })
-    }
-}
+crate::option_words!(Variant {
+    Radiance => "radiance",
+    Manual2004 => "manual2004",
+    Ward1992 => "ward1992",
+});

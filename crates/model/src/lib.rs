@@ -39,6 +39,7 @@ mod kind;
 mod material;
 mod options;
 pub mod rng;
+mod words;
 
 pub use albedo::{Albedo, albedo, gauss_legendre_rule};
 pub use batch::{Directions, RgbBatch, exp_lane};
@@ -49,8 +50,10 @@ pub use kind::{MaterialKind, Variant};
 pub use material::{FTINY, MAX_ARGS, Material, ModelError, check_args};
 pub use options::{
     EvalOptions, FRESNEL_K_CLASSIC, FRESNEL_K_PYRADIANCE, OptionError, check_incidence,
+    parse_fresnel_k,
 };
 pub use rng::Rng;
+pub use words::{OptionWords, WordError, parse_word};
 
 use glam::DVec3;
 

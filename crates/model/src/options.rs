@@ -11,6 +11,17 @@ pub const FRESNEL_K_CLASSIC: f64 = 0.002_879_899_16;
 /// pyradiance 1.3.1 (2023-11 → 2026-06). Tests against that rtrace use it.
 pub const FRESNEL_K_PYRADIANCE: f64 = 0.002_029_430_64;
 
+/// Reads a Fresnel constant: `classic`, `pyradiance` or a number.
+pub fn parse_fresnel_k(text: &str) -> Result<f64, String> {
+    match text.trim() {
+        "classic" => Ok(FRESNEL_K_CLASSIC),
+        "pyradiance" => Ok(FRESNEL_K_PYRADIANCE),
+        other => other
+            .parse::<f64>()
+            .map_err(|_| format!("expected classic, pyradiance or a number, found `{other}`")),
+    }
+}
+
 /// How to evaluate a material.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EvalOptions {

@@ -117,3 +117,23 @@ pub fn read_fit(e: brtf_fit::ReadFitError, path: &std::path::Path) -> PyErr {
 pub fn export(message: String) -> PyErr {
     error(Class::Export, message, None, None)
 }
+
+/// A fit, export or folder step that failed.
+pub fn workflow(e: brtf_workflow::WorkflowError) -> PyErr {
+    use brtf_workflow::WorkflowError;
+    match e {
+        WorkflowError::Usage(message) => error(Class::Fit, message, None, None),
+        WorkflowError::Option(e) => model(e.to_string()),
+        WorkflowError::Io(e) => {
+            let file = Some(e.path.display().to_string());
+            error(io_class(&e.source), e.to_string(), file, None)
+        }
+        WorkflowError::Read(e) => read(e),
+        WorkflowError::FitSet(e) => fit_set(e),
+        WorkflowError::ReadFit(e) => {
+            let path = e.path().to_path_buf();
+            read_fit(e, &path)
+        }
+        other => export(other.to_string()),
+    }
+}

@@ -3,20 +3,16 @@
 //! `brtf_radiance::export::write_exports`, `brtf_plot::write_plots`).
 
 use crate::errors::{self, Class};
-use crate::material::{Material, parse_kind, parse_variant};
+use crate::material::{Material, word};
 use crate::measurement::Measurement;
-use brtf_fit::{
-    ColourConversion, FitConfig, FitReport, FitResult, FitSetOptions, Interpolation, NoProgress,
-    Recipe, ResidualKind, RobustLoss, ScaleRule, SelectionOptions, WeightRule,
-};
-use brtf_gonio::Hemisphere;
-use brtf_gonio::klems::KlemsBasis;
-use brtf_io::{FolderUpdate, Producer, describe_outputs};
-use brtf_radiance::export::klems::{self, KlemsOptions};
+use brtf_fit::{FitReport, FitResult, NoProgress};
+use brtf_gonio::klems::{BasisSize, Sides};
+use brtf_radiance::export::klems::KlemsOptions;
+use brtf_workflow::{FitInputs, FitJob, FitSettings, Outputs, WorkflowError};
 use numpy::{IntoPyArray, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// One file path per input: a path, or a Measurement read from a file.
 fn input_paths(inputs: &Bound<'_, PyAny>) -> PyResult<Vec<PathBuf>> {
@@ -68,268 +64,42 @@ fn input_paths(inputs: &Bound<'_, PyAny>) -> PyResult<Vec<PathBuf>> {
     Ok(paths)
 }
 
-/// True when `path` starts like XML (a Klems BSDF file).
-fn is_klems(path: &Path) -> bool {
-    use std::io::Read;
-    let mut head = Vec::with_capacity(4096);
-    let opened = std::fs::File::open(path).and_then(|f| f.take(4096).read_to_end(&mut head));
-    opened.is_ok() && brtf_gonio::is_xml(&head)
-}
-
-/// The keyword arguments of `brtf.fit`, as `brtf fit`'s options.
-pub struct FitKwargs {
-    pub model: String,
-    pub gray: bool,
-    pub residual: String,
-    pub loss: String,
-    pub name: Option<String>,
-    pub variant: String,
-    pub fresnel_k: f64,
-    pub source_omega: f64,
-    pub orientation: [f64; 3],
-    pub floor: Option<f64>,
-    pub colour: String,
-    pub weights: String,
-    pub multistart: bool,
-    pub theta_cap: f64,
-    pub beam_mask: f64,
-    pub hemisphere: Option<String>,
-    pub min_value: Option<f64>,
-    pub mask_holder: bool,
-    pub beam_integral: Option<f64>,
-    pub rho: Option<(f64, f64)>,
-    pub free_scale: bool,
-    pub interpolation: String,
-    pub adequacy: bool,
-    /// Klems XML: the side fitted (`front` or `back`), the incidences kept
-    /// (`theta<=60`, …) and the view directions per outgoing patch.
-    pub side: Option<String>,
-    pub incidences: Option<String>,
-    pub patch_samples: usize,
-}
-
-/// A choice among fixed words, or a `brtf.ModelError` listing them.
-fn choose<T: Copy>(what: &str, value: &str, choices: &[(&str, T)]) -> PyResult<T> {
-    choices
-        .iter()
-        .find(|(k, _)| *k == value)
-        .map(|(_, v)| *v)
-        .ok_or_else(|| {
-            let names: Vec<&str> = choices.iter().map(|(k, _)| *k).collect();
-            errors::model(format!(
-                "{what}={value:?}: expected one of {}",
-                names.join(", ")
-            ))
-        })
-}
-
-impl FitKwargs {
-    /// The library options, mapped exactly as `brtf fit` maps its
-    /// arguments; `klems` for Klems BSDF XML inputs (one side).
-    fn options(&self, name: String, klems: bool) -> PyResult<FitSetOptions> {
-        let kind = parse_kind(&self.model)?;
-        if self.orientation.iter().all(|c| *c == 0.0) {
-            return Err(errors::model(
-                "orientation needs three numbers x, y, z, not all zero",
-            ));
-        }
-        let hemisphere = match self.hemisphere.as_deref() {
-            Some(h) => choose(
-                "hemisphere",
-                h,
-                &[
-                    ("front", Some(Hemisphere::Front)),
-                    ("back", Some(Hemisphere::Back)),
-                    ("both", None),
-                ],
-            )?,
-            None => SelectionOptions::default_hemisphere(kind),
-        };
-        let selections = SelectionOptions {
-            hemisphere,
-            theta_cap: self.theta_cap,
-            beam_mask: self.beam_mask,
-            min_value: self.min_value,
-            mask_holder: self.mask_holder,
-        }
-        .gates(klems);
-        let mut config = FitConfig::new(kind);
-        config.options.variant = parse_variant(&self.variant)?;
-        config.options.fresnel_k = self.fresnel_k;
-        config.options.source_omega = self.source_omega;
-        config.orientation = self.orientation;
-        config.gray = self.gray;
-        config.free_scale = self.free_scale;
-        config.residual = choose(
-            "residual",
-            &self.residual,
-            &[
-                ("absolute", ResidualKind::Absolute),
-                ("relative", ResidualKind::Relative),
-                ("log", ResidualKind::Log),
-            ],
-        )?;
-        config.floor = self.floor;
-        config.loss = self
-            .loss
-            .parse::<RobustLoss>()
-            .map_err(|e| errors::model(format!("loss={:?}: {e}", self.loss)))?;
-        config.multistart = self.multistart;
-        let options = FitSetOptions {
-            name,
-            config,
-            recipe: Recipe {
-                scale: match self.beam_integral {
-                    Some(value) => ScaleRule::BeamIntegral { value },
-                    None => ScaleRule::FromFiles,
-                },
-                colour: choose(
-                    "colour",
-                    &self.colour,
-                    &[
-                        ("xyz", ColourConversion::XyzToRadianceRgb),
-                        ("as_recorded", ColourConversion::AsRecorded),
-                    ],
-                )?,
-                selections,
-                weights: choose(
-                    "weights",
-                    &self.weights,
-                    &[
-                        ("solid_angle", WeightRule::SolidAngle),
-                        ("uniform", WeightRule::Uniform),
-                    ],
-                )?,
-                ..Recipe::for_kind(kind)
-            },
-            known_reflectance: self.rho,
-            interpolation: choose(
-                "interpolation",
-                &self.interpolation,
-                &[
-                    ("pchip", Interpolation::Pchip),
-                    ("linear", Interpolation::Linear),
-                ],
-            )?,
-            command_line: vec!["brtf.fit (Python)".into()],
-            adequacy: self.adequacy,
-            klems: brtf_fit::KlemsOptions {
-                side: match (klems, self.side.as_deref()) {
-                    (false, None) => None,
-                    (false, Some(_)) => {
-                        return Err(errors::model(
-                            "side= chooses the side of a Klems BSDF XML file",
-                        ));
-                    }
-                    (true, None) => {
-                        return Err(errors::model(
-                            "a Klems BSDF XML file is fitted one side at a time: side=\"front\" or \"back\"",
-                        ));
-                    }
-                    (true, Some(side)) => Some(choose(
-                        "side",
-                        side,
-                        &[
-                            ("front", brtf_gonio::klems::Side::Front),
-                            ("back", brtf_gonio::klems::Side::Back),
-                        ],
-                    )?),
-                },
-                incidences: match (klems, self.incidences.as_deref()) {
-                    (_, None) => None,
-                    (false, Some(_)) => {
-                        return Err(errors::model(
-                            "incidences= selects the incident patches of Klems BSDF XML files",
-                        ));
-                    }
-                    (true, Some(filter)) => Some(
-                        filter
-                            .parse::<brtf_fit::klems::IncidenceFilter>()
-                            .map_err(|e| errors::model(format!("incidences={filter:?}: {e}")))?,
-                    ),
-                },
-            },
-        };
-        if !(1..=4096).contains(&self.patch_samples) {
-            return Err(errors::model("patch_samples must be between 1 and 4096"));
-        }
-        let options = if klems {
-            options.for_klems(self.patch_samples)
-        } else {
-            options
-        };
-        options
-            .validate()
-            .map_err(|e| errors::model(e.to_string()))?;
-        Ok(options)
-    }
-}
-
-/// Runs the fit set: reads every file, fits, on `jobs` threads (all cores
-/// by default) with the GIL released.
+/// Runs the fit: reads every file and fits it, on `jobs` threads (all
+/// cores by default) with the GIL released. A Klems BSDF XML file is fitted
+/// one side at a time (`settings.sides` front or back).
 pub fn run_fit(
     py: Python<'_>,
     inputs: &Bound<'_, PyAny>,
-    kwargs: FitKwargs,
+    settings: FitSettings,
+    name: Option<String>,
     jobs: Option<usize>,
 ) -> PyResult<Fit> {
     let paths = input_paths(inputs)?;
-    let klems = paths.iter().filter(|p| is_klems(p)).count();
-    if klems > 0 && klems < paths.len() {
-        return Err(errors::error(
-            Class::Fit,
-            "Klems BSDF XML files are fitted on their own, not with gonio-photometer files".into(),
-            None,
-            None,
-        ));
-    }
-    let klems = klems > 0;
-    let name = match &kwargs.name {
-        Some(name) => name.clone(),
-        None => {
-            let mut sample_names = Vec::new();
-            for path in &paths {
-                let name = if klems {
-                    py.detach(|| brtf_gonio::klems::read_path(path))
-                        .map_err(|e| {
-                            errors::error(
-                                Class::Format,
-                                e.to_string(),
-                                Some(path.display().to_string()),
-                                None,
-                            )
-                        })?
-                        .header
-                        .name
-                } else {
-                    py.detach(|| brtf_gonio::read_path(path))
-                        .map_err(errors::read)?
-                        .sample_name
-                };
-                sample_names.push(name);
-            }
-            let stems: Vec<String> = paths
-                .iter()
-                .map(|f| {
-                    f.file_stem()
-                        .unwrap_or_default()
-                        .to_string_lossy()
-                        .into_owned()
-                })
-                .collect();
-            brtf_radiance::default_fit_name(&sample_names, &stems)
+    let inputs = FitInputs::classify(&paths).map_err(errors::workflow)?;
+    let side = match (inputs.is_klems(), settings.sides) {
+        (false, Sides::Both) => None,
+        (false, _) => {
+            return Err(errors::model(
+                "side= chooses the side of a Klems BSDF XML file",
+            ));
         }
+        (true, Sides::Both) => {
+            return Err(errors::model(
+                "a Klems BSDF XML file is fitted one side at a time: side=\"front\" or \"back\"",
+            ));
+        }
+        (true, sides) => sides.sides().first().copied(),
     };
-    let options = kwargs.options(name, klems)?;
-    let result = py.detach(|| -> Result<_, String> {
+    let command_line = vec!["brtf.fit (Python)".to_string()];
+    let fitted = py.detach(|| -> Result<_, WorkflowError> {
+        let job = FitJob::new(&inputs, &settings, name, command_line)?;
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(jobs.unwrap_or(0))
             .build()
-            .map_err(|e| format!("cannot start worker threads: {e}"))?;
-        Ok(pool.install(|| brtf_fit::fit_set(&paths, &options, &NoProgress)))
+            .map_err(|e| WorkflowError::Usage(format!("cannot start worker threads: {e}")))?;
+        pool.install(|| job.fit(side, &NoProgress))
     });
-    let result = result.map_err(|e| errors::error(Class::Fit, e, None, None))?;
-    let result = result.map_err(errors::fit_set)?;
+    let result = fitted.map_err(errors::workflow)?.result;
     Ok(Fit { result, paths })
 }
 
@@ -636,11 +406,12 @@ impl Fit {
         plots: bool,
         force: bool,
     ) -> PyResult<Vec<String>> {
-        let written =
-            py.detach(|| save_folder(&self.result, &self.paths, &folder, export, plots, force));
-        written.map_err(|(class, message)| {
-            errors::error(class, message, Some(folder.display().to_string()), None)
-        })
+        let outputs = Outputs { export, plots };
+        let saved = py.detach(|| {
+            brtf_workflow::save_fit(&self.result, &[], &self.paths, &folder, outputs, force)
+        });
+        let (files, _) = saved.map_err(errors::workflow)?;
+        Ok(files.iter().map(|f| f.display().to_string()).collect())
     }
 
     /// Writes the Radiance materials into `folder` (created if missing;
@@ -674,73 +445,35 @@ impl Fit {
         let klems_options = match klems.as_deref() {
             None => None,
             Some(basis) => {
-                let basis_name = choose(
-                    "klems",
-                    basis,
-                    &[
-                        ("full", "LBNL/Klems Full"),
-                        ("half", "LBNL/Klems Half"),
-                        ("quarter", "LBNL/Klems Quarter"),
-                    ],
-                )?;
-                let mut options = KlemsOptions::new(name.as_deref().unwrap_or(&self.result.name));
-                options.basis = KlemsBasis::built_in(basis_name)
-                    .ok_or_else(|| errors::model(format!("no built-in basis {basis_name}")))?;
+                let mut options = KlemsOptions::new("");
+                options.basis = word::<BasisSize>("klems", basis)?.basis();
                 options.colour = klems_colour;
                 options.command_line = vec!["brtf.Fit.export (Python)".into()];
                 Some(options)
             }
         };
         let options = brtf_radiance::export::ExportOptions {
-            name,
+            name: name.clone(),
             at,
             theta_dependent: !static_only,
             preview,
         };
-        let written = py.detach(|| -> Result<Vec<PathBuf>, String> {
-            let update = FolderUpdate::amend(&folder).map_err(|e| e.to_string())?;
-            let stage = update.path().to_path_buf();
-            let mut files = Vec::new();
-            if klems_options.is_some() && !stage.join("fit.json").is_file() {
-                self.result.write(&stage).map_err(|e| e.to_string())?;
-                files.push(stage.join("params.csv"));
-                files.push(stage.join("fit.json"));
-            }
-            let exported = brtf_radiance::export::write_exports(&stage, &self.result, &options)
-                .map_err(|e| e.to_string())?;
-            relist(&stage, &exported.files).map_err(|e| e.to_string())?;
-            files.extend(exported.files);
-            update.commit().map_err(|e| e.to_string())?;
-            if let Some(klems_options) = &klems_options {
+        let written = py.detach(|| -> Result<Vec<PathBuf>, WorkflowError> {
+            let mut files = match klems_options {
+                Some(_) => brtf_workflow::ensure_fit_json(&folder, &self.result)?,
+                None => Vec::new(),
+            };
+            files.extend(brtf_workflow::export_into(&folder, &self.result, &options)?.files);
+            if let Some(klems_options) = klems_options {
                 // As `brtf export DIR --klems`: from the folder's fit.json.
-                let export = klems::klems_from_fit_dir(&folder, klems_options)
-                    .map_err(|e| format!("exporting {} as Klems XML: {e}", folder.display()))?;
-                let update = FolderUpdate::amend(&folder).map_err(|e| e.to_string())?;
-                let staged = update.path().join(format!(
-                    "{}.xml",
-                    brtf_radiance::export::klems::klems_file_stem(&klems_options.name)
-                ));
-                klems::write_klems(&staged, &export).map_err(|e| e.to_string())?;
-                let listed =
-                    FitResult::read(&update.path().join("fit.json")).map_err(|e| e.to_string())?;
-                let mut fresh: Vec<PathBuf> = listed
-                    .outputs
-                    .iter()
-                    .filter(|o| o.by == Producer::Export && update.path().join(&o.path).is_file())
-                    .map(|o| update.path().join(&o.path))
-                    .filter(|p| *p != staged)
-                    .collect();
-                fresh.push(staged.clone());
-                relist(update.path(), &fresh).map_err(|e| e.to_string())?;
-                files.push(staged);
-                update.commit().map_err(|e| e.to_string())?;
+                let name = name.as_deref().unwrap_or(&self.result.name);
+                let (stem, export) =
+                    brtf_workflow::klems_of_fit_folder(&folder, Some(name), klems_options)?;
+                files.push(brtf_workflow::write_klems_into(&folder, &stem, &export)?);
             }
-            Ok(files
-                .iter()
-                .map(|f| folder.join(f.file_name().unwrap_or_default()))
-                .collect())
+            Ok(files)
         });
-        let files = written.map_err(errors::export)?;
+        let files = written.map_err(errors::workflow)?;
         Ok(files.iter().map(|f| f.display().to_string()).collect())
     }
 
@@ -760,63 +493,4 @@ impl Fit {
             global.unwrap_or_default()
         )
     }
-}
-
-/// `brtf fit`'s folder: the result, the exports, the plots, then
-/// `fit.json` listing them, written into a staging folder swapped in whole.
-fn save_folder(
-    result: &FitResult,
-    inputs: &[PathBuf],
-    out: &Path,
-    export: bool,
-    plots: bool,
-    force: bool,
-) -> Result<Vec<String>, (Class, String)> {
-    let io = |e: brtf_io::IoError| (Class::File, e.to_string());
-    let update = FolderUpdate::fresh(out).map_err(io)?;
-    brtf_io::check_replaceable(update.target(), inputs, force).map_err(io)?;
-    let stage = update.path();
-    let mut result = result.clone();
-    // fit.json is written once, last (below).
-    result.write_params_csv(stage).map_err(io)?;
-    let mut outputs =
-        describe_outputs(stage, &[stage.join("params.csv")], Producer::Fit).map_err(io)?;
-    if export {
-        let options = brtf_radiance::export::ExportOptions::default();
-        let exported = brtf_radiance::export::write_exports(stage, &result, &options)
-            .map_err(|e| (Class::Export, format!("exporting Radiance materials: {e}")))?;
-        outputs.extend(describe_outputs(stage, &exported.files, Producer::Export).map_err(io)?);
-    }
-    if plots {
-        let mut plot_options = brtf_plot::PlotOptions::default();
-        plot_options.search_dirs.push(out.to_path_buf());
-        let written = brtf_plot::write_plots(stage, &result, &plot_options)
-            .map_err(|e| (Class::Export, format!("plotting: {e}")))?;
-        outputs.extend(describe_outputs(stage, &written.files, Producer::Plot).map_err(io)?);
-    }
-    outputs.sort_by(|a, b| a.path.cmp(&b.path));
-    result.outputs = outputs;
-    // fit.json last: it lists every other file of the folder.
-    result.write_fit_json(stage).map_err(io)?;
-    let mut files: Vec<String> = result
-        .outputs
-        .iter()
-        .map(|o| out.join(&o.path).display().to_string())
-        .collect();
-    files.push(out.join("fit.json").display().to_string());
-    update.commit().map_err(io)?;
-    Ok(files)
-}
-
-/// When the folder holds a `fit.json`, lists the fresh exports in it in
-/// place of the old ones (as `brtf export` does).
-fn relist(stage: &Path, fresh: &[PathBuf]) -> Result<(), Box<dyn std::error::Error>> {
-    let path = stage.join("fit.json");
-    if !path.exists() {
-        return Ok(());
-    }
-    let mut fit = FitResult::read(&path)?;
-    let fresh = describe_outputs(stage, fresh, Producer::Export)?;
-    fit.outputs = brtf_io::replace_outputs(stage, &fit.outputs, fresh, Producer::Export)?;
-    Ok(brtf_io::write_atomic(&path, fit.to_json().as_bytes())?)
 }

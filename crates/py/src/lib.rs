@@ -55,39 +55,54 @@ fn fit_set(
     patch_samples: usize,
     jobs: Option<usize>,
 ) -> PyResult<fit::Fit> {
+    use material::word;
     let fresnel_k = match fresnel_k {
         Some(k) => material::parse_fresnel_k(k)?,
         None => brtf_model::FRESNEL_K_CLASSIC,
     };
-    let kwargs = fit::FitKwargs {
-        model: model.to_string(),
+    if orientation.iter().all(|c| *c == 0.0) {
+        return Err(errors::model(
+            "orientation needs three numbers x, y, z, not all zero",
+        ));
+    }
+    let settings = brtf_workflow::FitSettings {
         gray,
-        residual: residual.to_string(),
-        loss: loss.to_string(),
-        name,
-        variant: variant.to_string(),
+        variant: word("variant", variant)?,
         fresnel_k,
         source_omega,
         orientation,
+        residual: word("residual", residual)?,
         floor,
-        colour: colour.to_string(),
-        weights: weights.to_string(),
+        loss: loss
+            .parse::<brtf_fit::RobustLoss>()
+            .map_err(|e| errors::model(format!("loss={loss:?}: {e}")))?,
+        colour: word("colour", colour)?,
+        weights: word("weights", weights)?,
         multistart,
         theta_cap,
         beam_mask,
-        hemisphere,
+        hemisphere: hemisphere.map(|h| word("hemisphere", &h)).transpose()?,
         min_value,
         mask_holder,
         beam_integral,
-        rho,
+        rho: rho.map(|(rho, theta_in)| brtf_fit::KnownReflectance { rho, theta_in }),
         free_scale,
-        interpolation: interpolation.to_string(),
+        interpolation: word("interpolation", interpolation)?,
         adequacy,
-        side,
-        incidences,
+        sides: match side {
+            Some(side) => word::<brtf_gonio::klems::Side>("side", &side)?.into(),
+            None => brtf_gonio::klems::Sides::Both,
+        },
+        incidences: incidences
+            .map(|f| {
+                f.parse::<brtf_fit::klems::IncidenceFilter>()
+                    .map_err(|e| errors::model(format!("incidences={f:?}: {e}")))
+            })
+            .transpose()?,
         patch_samples,
+        ..brtf_workflow::FitSettings::new(word("model", model)?)
     };
-    fit::run_fit(py, inputs, kwargs, jobs)
+    fit::run_fit(py, inputs, settings, name, jobs)
 }
 
 #[pymodule]

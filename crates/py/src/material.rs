@@ -5,8 +5,7 @@
 use crate::errors;
 use crate::kernel;
 use brtf_model::{
-    Bsdf, EvalOptions, FRESNEL_K_CLASSIC, FRESNEL_K_PYRADIANCE, Material as Model, MaterialKind,
-    Variant,
+    Bsdf, EvalOptions, FRESNEL_K_CLASSIC, Material as Model, MaterialKind, Variant, WordError,
 };
 use glam::DVec3;
 use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1};
@@ -26,30 +25,20 @@ pub struct Material {
 /// `fresnel_k`: `"classic"`, `"pyradiance"` or a number.
 pub fn parse_fresnel_k(value: &Bound<'_, PyAny>) -> PyResult<f64> {
     if let Ok(text) = value.extract::<String>() {
-        return match text.as_str() {
-            "classic" => Ok(FRESNEL_K_CLASSIC),
-            "pyradiance" => Ok(FRESNEL_K_PYRADIANCE),
-            other => Err(errors::model(format!(
-                "fresnel_k={other:?}: expected \"classic\", \"pyradiance\" or a number"
-            ))),
-        };
+        return brtf_model::parse_fresnel_k(&text)
+            .map_err(|e| errors::model(format!("fresnel_k={text:?}: {e}")));
     }
     value
         .extract::<f64>()
         .map_err(|_| errors::model("fresnel_k: expected \"classic\", \"pyradiance\" or a number"))
 }
 
-/// A model name such as `metal` (a `brtf.ModelError` naming the six otherwise).
-pub fn parse_kind(kind: &str) -> PyResult<MaterialKind> {
-    kind.parse::<MaterialKind>()
-        .map_err(|e| errors::model(format!("model {kind:?}: {e}")))
-}
-
-/// `variant`: `radiance`, `manual2004` or `ward1992`.
-pub fn parse_variant(variant: &str) -> PyResult<Variant> {
-    variant
-        .parse::<Variant>()
-        .map_err(|e| errors::model(format!("variant {variant:?}: {e}")))
+/// The keyword argument `what=value` read as one of a library enum's words
+/// (a `brtf.ModelError` listing them otherwise).
+pub fn word<T: std::str::FromStr<Err = WordError>>(what: &str, value: &str) -> PyResult<T> {
+    value
+        .parse::<T>()
+        .map_err(|e| errors::model(format!("{what}={value:?}: {e}")))
 }
 
 /// The evaluation options, checked.
@@ -60,7 +49,7 @@ pub fn eval_options(
     curved: bool,
 ) -> PyResult<EvalOptions> {
     let options = EvalOptions {
-        variant: parse_variant(variant)?,
+        variant: word("variant", variant)?,
         fresnel_k: parse_fresnel_k(fresnel_k)?,
         source_omega,
         flat: !curved,
@@ -151,7 +140,7 @@ impl Material {
         source_omega: f64,
         curved: bool,
     ) -> PyResult<Material> {
-        let kind = parse_kind(kind)?;
+        let kind: MaterialKind = word("kind", kind)?;
         let classic = "classic".into_pyobject(py)?.into_any();
         let options = eval_options(variant, fresnel_k.unwrap_or(&classic), source_omega, curved)?;
         let args = match args {

@@ -115,7 +115,7 @@ impl Measurement {
     /// The file format, e.g. `pab-opto Mountain`.
     #[getter]
     fn format(&self) -> String {
-        self.scan.format.to_string()
+        self.scan.format.describe().to_string()
     }
 
     /// `#sample_name`, when the file has one.

@@ -47,6 +47,12 @@ pub enum SceneKind {
     Sphere,
 }
 
+brtf_model::option_words!(SceneKind {
+    SpherePlane => "sphere-plane",
+    Plane => "plane",
+    Sphere => "sphere",
+});
+
 impl SceneKind {
     /// True when the floor disk is in the scene.
     pub fn has_floor(self) -> bool {
@@ -67,6 +73,8 @@ pub enum LightKind {
     /// A spherical light (a `sphere` with a `light` material).
     Sphere,
 }
+
+brtf_model::option_words!(LightKind { Distant => "distant", Sphere => "sphere" });
 
 /// The light: its kind, where it is and how bright.
 #[derive(Debug, Clone, Copy, PartialEq)]

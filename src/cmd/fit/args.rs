@@ -1,15 +1,14 @@
-//! The arguments of `brtf fit` and the library options they mean.
+//! The arguments of `brtf fit` and the settings they mean.
 
 use crate::cmd::material::FormulaArgs;
-use anyhow::{Result, bail};
-use brtf_fit::{
-    ColourConversion, FitConfig, FitSetOptions, Interpolation, KnownReflectance, Recipe,
-    ResidualKind, RobustLoss, ScaleRule, SelectionOptions, WeightRule,
-};
-use brtf_gonio::Hemisphere;
-use brtf_gonio::klems::Side;
+use crate::cmd::shared::words;
+use brtf_fit::klems::IncidenceFilter;
+use brtf_fit::{ColourConversion, Interpolation, KnownReflectance, ResidualKind, RobustLoss};
+use brtf_fit::{WeightRule, en14501::En14501};
+use brtf_gonio::{Hemispheres, klems::Sides};
 use brtf_model::MaterialKind;
-use clap::{Args, ValueEnum};
+use brtf_workflow::{FitSettings, Outputs};
+use clap::Args;
 use std::path::PathBuf;
 
 #[derive(Args, Debug)]
@@ -20,15 +19,15 @@ pub struct FitArgs {
     /// .txt files), each fitted into OUT/<name>/.
     #[arg(required_unless_present = "en14501")]
     pub files: Vec<PathBuf>,
-    /// Model to fit: plastic, metal, trans, plastic2, metal2 or trans2.
-    #[arg(long, required_unless_present = "en14501", value_parser = |s: &str| s.parse::<MaterialKind>())]
+    /// Model to fit.
+    #[arg(long, required_unless_present = "en14501", value_parser = words::<MaterialKind>())]
     pub model: Option<MaterialKind>,
     /// No files: a grey roughness-0 `trans` from datasheet values at normal
     /// incidence (EN 14501), `tau_nh=…,tau_nn=…,rho_nh=…[,spec=…]`, printed
     /// as a Radiance material (docs/fitting.md, "EN 14501 shortcut").
     #[arg(long, value_name = "VALUES", conflicts_with_all = ["files", "model"],
-          value_parser = |s: &str| s.parse::<brtf_fit::en14501::En14501>())]
-    pub en14501: Option<brtf_fit::en14501::En14501>,
+          value_parser = |s: &str| s.parse::<En14501>())]
+    pub en14501: Option<En14501>,
     /// Tie R = G = B (always so for single-channel data).
     #[arg(long)]
     pub gray: bool,
@@ -56,8 +55,8 @@ pub struct FitArgs {
     )]
     pub orientation: Vec<f64>,
     /// How model and data are compared.
-    #[arg(long, value_enum, default_value_t = ResidualArg::Absolute)]
-    pub residual: ResidualArg,
+    #[arg(long, value_parser = words::<ResidualKind>(), default_value_t = ResidualKind::Absolute)]
+    pub residual: ResidualKind,
     /// Floor for relative/log residuals, in the data's unit [default: 10% of the 10th percentile].
     #[arg(long)]
     pub floor: Option<f64>,
@@ -66,11 +65,12 @@ pub struct FitArgs {
     pub loss: RobustLoss,
     /// What three-channel files hold: CIE X, Y, Z (converted to Radiance
     /// RGB), or RGB already (files from brtf before it wrote true XYZ).
-    #[arg(long, value_enum, default_value_t = ColourArg::Xyz)]
-    pub colour: ColourArg,
+    #[arg(long, value_parser = words::<ColourConversion>(),
+          default_value_t = ColourConversion::XyzToRadianceRgb)]
+    pub colour: ColourConversion,
     /// Fit weights: the samples' solid angles (file Voronoi cells, else computed) or uniform.
-    #[arg(long, value_enum, default_value_t = WeightsArg::SolidAngle)]
-    pub weights: WeightsArg,
+    #[arg(long, value_parser = words::<WeightRule>(), default_value_t = WeightRule::SolidAngle)]
+    pub weights: WeightRule,
     /// Start from the data-driven values only (no multi-start over roughness).
     #[arg(long)]
     pub no_multistart: bool,
@@ -81,8 +81,8 @@ pub struct FitArgs {
     #[arg(long, default_value_t = 3.0)]
     pub beam_mask: f64,
     /// Hemisphere(s) used [default: front for opaque models, both for trans].
-    #[arg(long, value_enum)]
-    pub hemisphere: Option<HemisphereArg>,
+    #[arg(long, value_parser = words::<Hemispheres>())]
+    pub hemisphere: Option<Hemispheres>,
     /// Drop samples whose value is below this (in the data's unit).
     #[arg(long)]
     pub min_value: Option<f64>,
@@ -100,8 +100,8 @@ pub struct FitArgs {
     #[arg(long)]
     pub free_scale: bool,
     /// θ_in interpolation of the parameters.
-    #[arg(long, value_enum, default_value_t = InterpArg::Pchip)]
-    pub interpolation: InterpArg,
+    #[arg(long, value_parser = words::<Interpolation>(), default_value_t = Interpolation::Pchip)]
+    pub interpolation: Interpolation,
     /// Skip the adequacy diagnostics (energy, peak, and the second fit with
     /// another residual kind).
     #[arg(long)]
@@ -117,168 +117,64 @@ pub struct FitArgs {
     pub no_plots: bool,
     /// Klems XML: the side(s) fitted, each on its own (front = light from
     /// +z, Radiance's front; WINDOW calls it the back).
-    #[arg(long, value_enum, default_value_t = SideArg::Both)]
-    pub side: SideArg,
+    #[arg(long, value_parser = words::<Sides>(), default_value_t = Sides::Both)]
+    pub side: Sides,
     /// Klems XML: which incident patches, e.g. `theta<=60` or
     /// `theta>=10,theta<70` [default: all].
-    #[arg(long, value_parser = |s: &str| s.parse::<brtf_fit::klems::IncidenceFilter>())]
-    pub incidences: Option<brtf_fit::klems::IncidenceFilter>,
+    #[arg(long, value_parser = |s: &str| s.parse::<IncidenceFilter>())]
+    pub incidences: Option<IncidenceFilter>,
     /// Klems XML: stratified directions per outgoing patch over which the
     /// model is averaged.
     #[arg(long, default_value_t = brtf_fit::PatchAveraging::default().outgoing_samples)]
     pub patch_samples: usize,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, ValueEnum)]
-pub enum SideArg {
-    Front,
-    Back,
-    Both,
-}
-
-impl SideArg {
-    /// The sides fitted.
-    pub fn sides(self) -> Vec<Side> {
-        match self {
-            SideArg::Front => vec![Side::Front],
-            SideArg::Back => vec![Side::Back],
-            SideArg::Both => Side::BOTH.to_vec(),
-        }
-    }
-}
-
-/// True when `path` is a Klems BSDF XML file (by its extension or its
-/// first bytes), as `brtf_gonio::detect_format` decides.
-pub fn is_klems(path: &std::path::Path) -> bool {
-    use std::io::Read;
-    let mut head = Vec::new();
-    if let Ok(file) = std::fs::File::open(path) {
-        let _ = file.take(512).read_to_end(&mut head);
-    }
-    brtf_gonio::detect_format(&head, path) == brtf_gonio::SourceFormat::KlemsXml
-}
-
-#[derive(Clone, Copy, Debug, ValueEnum)]
-pub enum ResidualArg {
-    Relative,
-    Absolute,
-    Log,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, ValueEnum)]
-pub enum ColourArg {
-    /// Three channels are CIE X, Y, Z: converted to Radiance RGB.
-    Xyz,
-    /// Three channels are Radiance RGB already.
-    AsRecorded,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, ValueEnum)]
-pub enum WeightsArg {
-    SolidAngle,
-    Uniform,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, ValueEnum)]
-pub enum HemisphereArg {
-    Front,
-    Back,
-    Both,
-}
-
-#[derive(Clone, Copy, Debug, ValueEnum)]
-pub enum InterpArg {
-    Pchip,
-    Linear,
-}
-
 impl FitArgs {
-    /// The library's options for these arguments.
-    pub fn options(&self, name: String) -> Result<FitSetOptions> {
+    /// The fit settings these arguments give.
+    pub fn settings(&self) -> anyhow::Result<FitSettings> {
         let Some(model) = self.model else {
-            bail!("--model is needed to fit measurement files");
+            anyhow::bail!("--model is needed to fit measurement files");
         };
-        let [x, y, z] = self.orientation[..] else {
-            bail!("--orientation needs three numbers x,y,z, not all zero");
+        let Ok(orientation) = <[f64; 3]>::try_from(&self.orientation[..]) else {
+            anyhow::bail!("--orientation needs three numbers x,y,z, not all zero");
         };
-        if [x, y, z].iter().all(|c| *c == 0.0) {
-            bail!("--orientation needs three numbers x,y,z, not all zero");
+        if orientation.iter().all(|c| *c == 0.0) {
+            anyhow::bail!("--orientation needs three numbers x,y,z, not all zero");
         }
-        let hemisphere = match self.hemisphere {
-            Some(HemisphereArg::Front) => Some(Hemisphere::Front),
-            Some(HemisphereArg::Back) => Some(Hemisphere::Back),
-            Some(HemisphereArg::Both) => None,
-            None => SelectionOptions::default_hemisphere(model),
-        };
-        let klems = self.files.iter().filter(|f| is_klems(f)).count();
-        if klems > 0 && klems < self.files.len() {
-            bail!("Klems BSDF XML files are fitted on their own, not with gonio-photometer files");
-        }
-        let klems = klems > 0;
-        if !klems && self.incidences.is_some() {
-            bail!("--incidences selects the incident patches of Klems BSDF XML files");
-        }
-        if self.patch_samples == 0 || self.patch_samples > 4096 {
-            bail!("--patch-samples must be between 1 and 4096");
-        }
-        let selections = SelectionOptions {
-            hemisphere,
+        Ok(FitSettings {
+            gray: self.gray,
+            variant: self.formula.variant,
+            fresnel_k: self.formula.fresnel_k,
+            source_omega: self.source_omega,
+            orientation,
+            residual: self.residual,
+            floor: self.floor,
+            loss: self.loss,
+            colour: self.colour,
+            weights: self.weights,
+            multistart: !self.no_multistart,
             theta_cap: self.theta_cap,
             beam_mask: self.beam_mask,
+            hemisphere: self.hemisphere,
             min_value: self.min_value,
             mask_holder: self.mask_holder,
-        }
-        .gates(klems);
-        let mut config = FitConfig::new(model);
-        config.options.variant = self.formula.variant;
-        config.options.fresnel_k = self.formula.fresnel_k;
-        config.options.source_omega = self.source_omega;
-        config.orientation = [x, y, z];
-        config.gray = self.gray;
-        config.free_scale = self.free_scale;
-        config.residual = match self.residual {
-            ResidualArg::Relative => ResidualKind::Relative,
-            ResidualArg::Absolute => ResidualKind::Absolute,
-            ResidualArg::Log => ResidualKind::Log,
-        };
-        config.floor = self.floor;
-        config.loss = self.loss;
-        config.multistart = !self.no_multistart;
-        let options = FitSetOptions {
-            name,
-            config,
-            recipe: Recipe {
-                scale: match self.beam_integral {
-                    Some(value) => ScaleRule::BeamIntegral { value },
-                    None => ScaleRule::FromFiles,
-                },
-                colour: match self.colour {
-                    ColourArg::Xyz => ColourConversion::XyzToRadianceRgb,
-                    ColourArg::AsRecorded => ColourConversion::AsRecorded,
-                },
-                selections,
-                weights: match self.weights {
-                    WeightsArg::SolidAngle => WeightRule::SolidAngle,
-                    WeightsArg::Uniform => WeightRule::Uniform,
-                },
-                patch_average: None,
-            },
-            known_reflectance: self.rho.map(|k| (k.rho, k.theta_in)),
-            interpolation: match self.interpolation {
-                InterpArg::Pchip => Interpolation::Pchip,
-                InterpArg::Linear => Interpolation::Linear,
-            },
-            command_line: std::env::args().collect(),
+            beam_integral: self.beam_integral,
+            rho: self.rho,
+            free_scale: self.free_scale,
+            interpolation: self.interpolation,
             adequacy: !self.no_adequacy,
-            klems: brtf_fit::KlemsOptions {
-                side: None,
-                incidences: self.incidences.clone(),
-            },
-        };
-        Ok(if klems {
-            options.for_klems(self.patch_samples)
-        } else {
-            options
+            sides: self.side,
+            incidences: self.incidences.clone(),
+            patch_samples: self.patch_samples,
+            ..FitSettings::new(model)
         })
+    }
+
+    /// The optional outputs asked for.
+    pub fn outputs(&self) -> Outputs {
+        Outputs {
+            export: !self.no_export,
+            plots: !self.no_plots,
+        }
     }
 }

@@ -1,13 +1,13 @@
 //! `brtf render gonio`: the virtual gonio-photometer.
 
 use super::SampleMaterial;
-use crate::cmd::shared::{csv_stdout, with_jobs, write_numbers};
+use crate::cmd::shared::{csv_stdout, with_jobs, words, write_numbers};
 use anyhow::{Context, Result, bail};
 use brtf_gonio::{Channels, Measurement, SourceFormat};
 use brtf_trace::gonio::{
     Aperture, GonioSetup, VirtualGonio, aperture_solid_angle, grid, measurement_from,
 };
-use clap::{Args, ValueEnum};
+use clap::Args;
 use glam::DVec3;
 use std::path::PathBuf;
 
@@ -54,8 +54,8 @@ pub struct GonioArgs {
     /// Values per sample in the output file: `y` (luminance) or `rgb`
     /// (the material's colour, written as CIE X, Y, Z) [default: the --like
     /// file's, else y].
-    #[arg(long, value_enum)]
-    pub channels: Option<ChannelsArg>,
+    #[arg(long, value_parser = words::<Channels>())]
+    pub channels: Option<Channels>,
     /// Output measurement file: `.mpc` (ISE) or anything else (Mountain).
     /// Without it, CSV goes to stdout.
     #[arg(long, value_name = "FILE")]
@@ -66,12 +66,6 @@ pub struct GonioArgs {
     /// Overwrite --out even when it is the --like or --material file.
     #[arg(long)]
     pub force: bool,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, ValueEnum)]
-pub enum ChannelsArg {
-    Y,
-    Rgb,
 }
 
 pub fn run(args: GonioArgs) -> Result<()> {
@@ -126,13 +120,11 @@ pub fn run(args: GonioArgs) -> Result<()> {
         }
         _ => SourceFormat::Mountain,
     };
-    let mut channels = match args.channels {
-        Some(ChannelsArg::Y) => Channels::Y,
-        Some(ChannelsArg::Rgb) => Channels::Xyz,
-        None => like.as_ref().map_or(Channels::Y, |m| m.channels),
-    };
+    let mut channels = args
+        .channels
+        .unwrap_or_else(|| like.as_ref().map_or(Channels::Y, |m| m.channels));
     if out_format == SourceFormat::Mpc && args.out.is_some() {
-        if args.channels == Some(ChannelsArg::Rgb) {
+        if args.channels == Some(Channels::Xyz) {
             bail!(".mpc holds one channel; use --channels y or a Mountain file");
         }
         channels = Channels::Y;

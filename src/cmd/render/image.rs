@@ -2,12 +2,12 @@
 
 use super::SampleMaterial;
 use crate::cmd::output::write_atomic;
-use crate::cmd::shared::with_jobs;
+use crate::cmd::shared::{with_jobs, words};
 use anyhow::Result;
 use brtf_trace::image::{auto_exposure, write_png};
 use brtf_trace::scene_spec::MATERIAL_NAME;
 use brtf_trace::{LightKind, LightSpec, SceneKind, SceneSpec, Settings, ViewSpec, hdr};
-use clap::{Args, ValueEnum};
+use clap::Args;
 use std::path::PathBuf;
 
 /// The defaults (shown by `--help`) are [`SceneSpec::DEFAULT`]'s.
@@ -33,12 +33,12 @@ pub struct ImageArgs {
     /// Random seed.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// What to show.
-    #[arg(long, value_enum, default_value_t = SceneArg::SpherePlane)]
-    pub scene: SceneArg,
-    /// The light source.
-    #[arg(long, value_enum, default_value_t = LightArg::Distant)]
-    pub light: LightArg,
+    /// What to show: sphere-plane (a unit sphere on a disk of radius 6), plane or sphere.
+    #[arg(long, value_parser = words::<SceneKind>(), default_value_t = SceneKind::SpherePlane)]
+    pub scene: SceneKind,
+    /// The light source: distant (a Radiance `source`) or sphere (a lamp).
+    #[arg(long, value_parser = words::<LightKind>(), default_value_t = LightKind::Distant)]
+    pub light: LightKind,
     /// Polar angle of the light (from the zenith), degrees.
     #[arg(long, default_value_t = D.light.theta)]
     pub light_theta: f64,
@@ -102,38 +102,13 @@ pub struct ImageArgs {
     pub jobs: Option<usize>,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, ValueEnum)]
-pub enum SceneArg {
-    /// A unit sphere standing on a disk of radius 6.
-    SpherePlane,
-    /// The disk only.
-    Plane,
-    /// The sphere only.
-    Sphere,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, ValueEnum)]
-pub enum LightArg {
-    /// A distant source (Radiance `source`).
-    Distant,
-    /// A spherical light (a `sphere` with a `light` material).
-    Sphere,
-}
-
 impl ImageArgs {
     /// The picture scene these options describe.
     fn spec(&self) -> SceneSpec {
         SceneSpec {
-            scene: match self.scene {
-                SceneArg::SpherePlane => SceneKind::SpherePlane,
-                SceneArg::Plane => SceneKind::Plane,
-                SceneArg::Sphere => SceneKind::Sphere,
-            },
+            scene: self.scene,
             light: LightSpec {
-                kind: match self.light {
-                    LightArg::Distant => LightKind::Distant,
-                    LightArg::Sphere => LightKind::Sphere,
-                },
+                kind: self.light,
                 theta: self.light_theta,
                 phi: self.light_phi,
                 apex: self.light_apex,

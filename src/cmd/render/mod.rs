@@ -16,11 +16,11 @@
 pub mod gonio;
 pub mod image;
 
-use super::material::{MaterialArgs, parse_fresnel_k, parse_variant};
-use super::shared::read_fit;
+use super::material::{FormulaArgs, MaterialArgs};
+use super::shared::words;
 use anyhow::{Context, Result};
 use brtf_fit::FitResult;
-use brtf_model::{FRESNEL_K_CLASSIC, Material, Variant};
+use brtf_model::{FRESNEL_K_CLASSIC, Material, Variant, parse_fresnel_k};
 use brtf_trace::Shader;
 use clap::{Args, Subcommand};
 use gonio::GonioArgs;
@@ -69,7 +69,7 @@ pub struct SampleMaterial {
     #[arg(long = "static", requires = "fit")]
     pub static_material: bool,
     /// Formula set [default: radiance, or the fit's].
-    #[arg(long, value_parser = parse_variant)]
+    #[arg(long, value_parser = words::<Variant>())]
     pub variant: Option<Variant>,
     /// Fresnel constant for roughness-0 surfaces: classic, pyradiance or a
     /// number [default: classic, or the fit's].
@@ -90,7 +90,7 @@ pub struct Loaded {
 impl SampleMaterial {
     pub fn load(&self) -> Result<Loaded> {
         if let Some(dir) = &self.fit {
-            let fit = read_fit(dir)?;
+            let fit = brtf_workflow::read_fit(dir)?;
             let mut options = fit.options();
             if let Some(v) = self.variant {
                 options.variant = v;
@@ -119,8 +119,10 @@ impl SampleMaterial {
         let args = MaterialArgs {
             material: file,
             name: self.name.clone(),
-            variant: self.variant.unwrap_or_default(),
-            fresnel_k: self.fresnel_k.unwrap_or(FRESNEL_K_CLASSIC),
+            formula: FormulaArgs {
+                variant: self.variant.unwrap_or_default(),
+                fresnel_k: self.fresnel_k.unwrap_or(FRESNEL_K_CLASSIC),
+            },
             source_omega: 0.0,
             curved: false,
         };

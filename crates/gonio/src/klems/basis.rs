@@ -143,6 +143,28 @@ const BUILT_IN: [(&str, &[f64], &[usize]); 3] = [
 /// hostile file from asking for a huge matrix.
 pub const MAX_PATCHES: usize = 4096;
 
+/// The three built-in Klems bases by size.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum BasisSize {
+    /// `LBNL/Klems Full`: 145 patches.
+    #[default]
+    Full,
+    /// `LBNL/Klems Half`: 73 patches.
+    Half,
+    /// `LBNL/Klems Quarter`: 41 patches.
+    Quarter,
+}
+
+brtf_model::option_words!(BasisSize { Full => "full", Half => "half", Quarter => "quarter" });
+
+impl BasisSize {
+    /// The basis.
+    pub fn basis(self) -> KlemsBasis {
+        let (name, _, _) = BUILT_IN[self as usize];
+        KlemsBasis::built_in(name).expect("a built-in basis")
+    }
+}
+
 impl KlemsBasis {
     /// The Klems Full basis (145 patches).
     pub fn full() -> Self {

@@ -31,7 +31,7 @@ use crate::measurement::{
     Channels, Incidence, IncidenceOrigin, Measurement, Quantity, Sample, SourceFormat,
 };
 
-pub use basis::{KlemsBasis, KlemsPatch, KlemsRing};
+pub use basis::{BasisSize, KlemsBasis, KlemsPatch, KlemsRing};
 pub use read::{read_bytes, read_path, read_str};
 pub use write::{KlemsWriteBlock, KlemsWriteHeader, to_klems_xml};
 
@@ -152,10 +152,7 @@ impl Side {
 
     /// `front` or `back`.
     pub fn name(self) -> &'static str {
-        match self {
-            Side::Front => "front",
-            Side::Back => "back",
-        }
+        brtf_model::OptionWords::word(self)
     }
 
     /// A polar angle θ (0-90° from this side's normal) in brtf's frame,
@@ -176,9 +173,39 @@ impl Side {
     }
 }
 
-impl fmt::Display for Side {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
+brtf_model::option_words!(Side { Front => "front", Back => "back" });
+
+/// The sides a Klems fit takes: one, or both (each its own fit).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Sides {
+    /// Light from +z only.
+    Front,
+    /// Light from −z only.
+    Back,
+    /// Both sides.
+    #[default]
+    Both,
+}
+
+brtf_model::option_words!(Sides { Front => "front", Back => "back", Both => "both" });
+
+impl From<Side> for Sides {
+    fn from(side: Side) -> Sides {
+        match side {
+            Side::Front => Sides::Front,
+            Side::Back => Sides::Back,
+        }
+    }
+}
+
+impl Sides {
+    /// The sides, front first.
+    pub fn sides(self) -> Vec<Side> {
+        match self {
+            Sides::Front => vec![Side::Front],
+            Sides::Back => vec![Side::Back],
+            Sides::Both => Side::BOTH.to_vec(),
+        }
     }
 }
 

@@ -1,0 +1,128 @@
+//! What a fit is given: measurement files, Klems BSDF XML files, or sample
+//! folders; and the material name they imply.
+
+use crate::WorkflowError;
+use std::path::{Path, PathBuf};
+
+/// The inputs of one `brtf fit`, by kind.
+#[derive(Debug, Clone, PartialEq)]
+pub enum FitInputs {
+    /// Gonio-photometer files (`.mpc`, Mountain), one incidence each: one sample.
+    Measurements(Vec<PathBuf>),
+    /// Klems BSDF XML files: each incident patch of a side is an incidence.
+    Klems(Vec<PathBuf>),
+    /// Sample folders, one sample each (their `.mpc` and `.txt` files).
+    Samples(Vec<PathBuf>),
+}
+
+impl FitInputs {
+    /// Sorts `paths` into one kind; mixing kinds is refused.
+    pub fn classify(paths: &[PathBuf]) -> Result<FitInputs, WorkflowError> {
+        if paths.is_empty() {
+            return Err(WorkflowError::Usage("no measurement files given".into()));
+        }
+        if paths.iter().any(|p| p.is_dir()) {
+            if let Some(file) = paths.iter().find(|p| !p.is_dir()) {
+                return Err(WorkflowError::Usage(format!(
+                    "{} is a file, but other inputs are folders: give either measurement files \
+                     (one sample) or sample folders (one sample each), not both",
+                    file.display()
+                )));
+            }
+            return Ok(FitInputs::Samples(paths.to_vec()));
+        }
+        let klems = paths.iter().filter(|p| is_klems(p)).count();
+        match klems {
+            0 => Ok(FitInputs::Measurements(paths.to_vec())),
+            n if n == paths.len() => Ok(FitInputs::Klems(paths.to_vec())),
+            _ => Err(WorkflowError::Usage(
+                "Klems BSDF XML files are fitted on their own, not with gonio-photometer files"
+                    .into(),
+            )),
+        }
+    }
+
+    /// The files (or folders) given.
+    pub fn paths(&self) -> &[PathBuf] {
+        match self {
+            FitInputs::Measurements(p) | FitInputs::Klems(p) | FitInputs::Samples(p) => p,
+        }
+    }
+
+    /// True for Klems BSDF XML inputs.
+    pub fn is_klems(&self) -> bool {
+        matches!(self, FitInputs::Klems(_))
+    }
+}
+
+/// True when `path` is a Klems BSDF XML file (by its extension or its
+/// first bytes), as [`brtf_gonio::detect_format`] decides.
+pub fn is_klems(path: &Path) -> bool {
+    use std::io::Read;
+    let mut head = Vec::new();
+    if let Ok(file) = std::fs::File::open(path) {
+        let _ = file.take(512).read_to_end(&mut head);
+    }
+    brtf_gonio::detect_format(&head, path) == brtf_gonio::SourceFormat::KlemsXml
+}
+
+/// The material name of one sample's files: their `#sample_name` (or the
+/// Klems header's name) when they agree, else the longest common start of
+/// their file names ([`brtf_radiance::default_fit_name`]).
+pub fn default_name(files: &[PathBuf], klems: bool) -> Result<String, WorkflowError> {
+    let mut sample_names = Vec::new();
+    for file in files {
+        let name = if klems {
+            brtf_gonio::klems::read_path(file)?.header.name
+        } else {
+            // The header alone: the fit reads and checks the whole file.
+            brtf_gonio::read_sample_name_at(file).map_err(|source| {
+                WorkflowError::Io(brtf_io::IoError {
+                    path: file.clone(),
+                    what: "cannot read",
+                    source,
+                })
+            })?
+        };
+        sample_names.push(name);
+    }
+    let stems: Vec<String> = files
+        .iter()
+        .map(|f| {
+            f.file_stem()
+                .unwrap_or_default()
+                .to_string_lossy()
+                .into_owned()
+        })
+        .collect();
+    Ok(brtf_radiance::default_fit_name(&sample_names, &stems))
+}
+
+/// The measurement files of a sample folder: `.mpc` and `.txt`, sorted.
+pub fn sample_files(folder: &Path) -> Result<Vec<PathBuf>, WorkflowError> {
+    let listing = |source| {
+        WorkflowError::Io(brtf_io::IoError {
+            path: folder.to_path_buf(),
+            what: "cannot list",
+            source,
+        })
+    };
+    let mut files = Vec::new();
+    for entry in std::fs::read_dir(folder).map_err(listing)? {
+        let path = entry.map_err(listing)?.path();
+        let measured = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("mpc") || e.eq_ignore_ascii_case("txt"));
+        if measured && path.is_file() {
+            files.push(path);
+        }
+    }
+    if files.is_empty() {
+        return Err(WorkflowError::Usage(format!(
+            "{} holds no measurement files (.mpc or .txt)",
+            folder.display()
+        )));
+    }
+    files.sort();
+    Ok(files)
+}

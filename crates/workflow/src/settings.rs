@@ -1,0 +1,175 @@
+//! What a user chooses for a fit, typed: the one place the front ends'
+//! options become [`FitSetOptions`].
+
+use crate::WorkflowError;
+use brtf_fit::klems::IncidenceFilter;
+use brtf_fit::{
+    ColourConversion, FitConfig, FitSetOptions, Interpolation, KnownReflectance, Recipe,
+    ResidualKind, RobustLoss, ScaleRule, SelectionOptions, WeightRule,
+};
+use brtf_gonio::Hemispheres;
+use brtf_gonio::klems::Sides;
+use brtf_model::{FRESNEL_K_CLASSIC, MaterialKind, Variant};
+
+/// The most view directions per outgoing Klems patch.
+pub const MAX_PATCH_SAMPLES: usize = 4096;
+
+/// Every fit option of `brtf fit` and `brtf.fit`, with their defaults.
+#[derive(Debug, Clone)]
+pub struct FitSettings {
+    /// The model fitted.
+    pub model: MaterialKind,
+    /// Tie R = G = B.
+    pub gray: bool,
+    /// Formula set.
+    pub variant: Variant,
+    /// Fresnel constant of roughness-0 surfaces.
+    pub fresnel_k: f64,
+    /// The source's solid angle, sr.
+    pub source_omega: f64,
+    /// Orientation vector of the anisotropic types.
+    pub orientation: [f64; 3],
+    /// How model and data are compared.
+    pub residual: ResidualKind,
+    /// Floor of relative and log residuals.
+    pub floor: Option<f64>,
+    /// Robust loss.
+    pub loss: RobustLoss,
+    /// What three-channel files hold.
+    pub colour: ColourConversion,
+    /// The samples' weights.
+    pub weights: WeightRule,
+    /// Multi-start over roughness.
+    pub multistart: bool,
+    /// Largest θ_out fitted, degrees.
+    pub theta_cap: f64,
+    /// Half-angle of the masked cone around the beam, degrees.
+    pub beam_mask: f64,
+    /// Hemispheres fitted (`None`: front for opaque models, both for trans).
+    pub hemisphere: Option<Hemispheres>,
+    /// Samples below this value are dropped.
+    pub min_value: Option<f64>,
+    /// Mask the pgII holder's shadow.
+    pub mask_holder: bool,
+    /// Beam integral that makes raw-signal files absolute.
+    pub beam_integral: Option<f64>,
+    /// A known reflectance that makes a raw-signal fit absolute.
+    pub rho: Option<KnownReflectance>,
+    /// Fit a free scale even on absolute data.
+    pub free_scale: bool,
+    /// θ_in interpolation of the table.
+    pub interpolation: Interpolation,
+    /// Run the adequacy diagnostics.
+    pub adequacy: bool,
+    /// Klems XML: the sides fitted.
+    pub sides: Sides,
+    /// Klems XML: which incident patches.
+    pub incidences: Option<IncidenceFilter>,
+    /// Klems XML: view directions per outgoing patch.
+    pub patch_samples: usize,
+}
+
+impl FitSettings {
+    /// The defaults for fitting `model`.
+    pub fn new(model: MaterialKind) -> FitSettings {
+        FitSettings {
+            model,
+            gray: false,
+            variant: Variant::default(),
+            fresnel_k: FRESNEL_K_CLASSIC,
+            source_omega: 0.0,
+            orientation: [1.0, 0.0, 0.0],
+            residual: ResidualKind::default(),
+            floor: None,
+            loss: RobustLoss::None,
+            colour: ColourConversion::XyzToRadianceRgb,
+            weights: WeightRule::SolidAngle,
+            multistart: true,
+            theta_cap: brtf_gonio::DEFAULT_THETA_CAP_DEG,
+            beam_mask: 3.0,
+            hemisphere: None,
+            min_value: None,
+            mask_holder: false,
+            beam_integral: None,
+            rho: None,
+            free_scale: false,
+            interpolation: Interpolation::default(),
+            adequacy: true,
+            sides: Sides::default(),
+            incidences: None,
+            patch_samples: brtf_fit::PatchAveraging::default().outgoing_samples,
+        }
+    }
+
+    /// The library's options for a fit named `name`; `klems` when the
+    /// inputs are Klems BSDF XML. Checks every value.
+    pub fn options(
+        &self,
+        name: String,
+        klems: bool,
+        command_line: Vec<String>,
+    ) -> Result<FitSetOptions, WorkflowError> {
+        if !klems && self.incidences.is_some() {
+            return Err(WorkflowError::Usage(
+                "--incidences selects the incident patches of Klems BSDF XML files".into(),
+            ));
+        }
+        if !(1..=MAX_PATCH_SAMPLES).contains(&self.patch_samples) {
+            return Err(WorkflowError::Usage(format!(
+                "--patch-samples must be between 1 and {MAX_PATCH_SAMPLES}"
+            )));
+        }
+        let hemisphere = match self.hemisphere {
+            Some(h) => h.only(),
+            None => SelectionOptions::default_hemisphere(self.model),
+        };
+        let selections = SelectionOptions {
+            hemisphere,
+            theta_cap: self.theta_cap,
+            beam_mask: self.beam_mask,
+            min_value: self.min_value,
+            mask_holder: self.mask_holder,
+        }
+        .gates(klems);
+        let mut config = FitConfig::new(self.model);
+        config.options.variant = self.variant;
+        config.options.fresnel_k = self.fresnel_k;
+        config.options.source_omega = self.source_omega;
+        config.orientation = self.orientation;
+        config.gray = self.gray;
+        config.free_scale = self.free_scale;
+        config.residual = self.residual;
+        config.floor = self.floor;
+        config.loss = self.loss;
+        config.multistart = self.multistart;
+        let options = FitSetOptions {
+            name,
+            config,
+            recipe: Recipe {
+                scale: match self.beam_integral {
+                    Some(value) => ScaleRule::BeamIntegral { value },
+                    None => ScaleRule::FromFiles,
+                },
+                colour: self.colour,
+                selections,
+                weights: self.weights,
+                patch_average: None,
+            },
+            known_reflectance: self.rho.map(|k| (k.rho, k.theta_in)),
+            interpolation: self.interpolation,
+            command_line,
+            adequacy: self.adequacy,
+            klems: brtf_fit::KlemsOptions {
+                side: None,
+                incidences: self.incidences.clone(),
+            },
+        };
+        let options = if klems {
+            options.for_klems(self.patch_samples)
+        } else {
+            options
+        };
+        options.validate()?;
+        Ok(options)
+    }
+}
