@@ -4,7 +4,7 @@
 use super::output::write_atomic;
 use super::shared::with_jobs;
 use anyhow::Result;
-use brtf_trace::check::{CheckOptions, check_fit};
+use brtf_trace::{CheckOptions, check_fit};
 use clap::Args;
 use std::path::PathBuf;
 

@@ -55,7 +55,7 @@ pub struct KlemsArgs {
     /// Samples per Klems matrix entry: quasi-random points of the outgoing
     /// × incident patch (16× near the horizon, 4× above 75°).
     #[arg(long, value_name = "N", requires = "klems",
-          default_value_t = brtf_gonio::klems::model_matrix::DEFAULT_SAMPLES)]
+          default_value_t = brtf_gonio::klems::DEFAULT_SAMPLES)]
     pub klems_samples: usize,
     /// Add a Solar band: `visible` repeats the Visible values (said in the
     /// header as an assumption), or a Radiance file with a material of the

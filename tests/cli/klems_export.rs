@@ -5,7 +5,7 @@
 
 use crate::common::{brtf, s, temp_dir, write_file};
 use brtf_gonio::klems::{self, KlemsBand, KlemsDirection, Side};
-use brtf_model::{Bsdf, EvalOptions, albedo, colour};
+use brtf_model::{Bsdf, EvalOptions, albedo};
 use std::path::{Path, PathBuf};
 
 const TRUTH: &str = "void trans shade\n0\n0\n7 0.6 0.5 0.4 0.03 0.15 0.3 0.2\n";
@@ -114,7 +114,7 @@ fn export_from_a_fit_reads_back_with_its_totals() {
         let material = table.at(p.theta_in_deg).unwrap().material;
         let bsdf = Bsdf::new(&material, &EvalOptions::default());
         let a = albedo(&bsdf, brtf_model::direction(p.theta_in_deg, 0.0), 1e-6);
-        let (rho, tau) = (colour::luminance(a.rho), colour::luminance(a.tau));
+        let (rho, tau) = (brtf_model::luminance(a.rho), brtf_model::luminance(a.tau));
         let (got_rho, got_tau) = (p.rho_dh.unwrap(), p.tau_dh.unwrap());
         assert!(
             (got_rho / rho - 1.0).abs() <= 0.01 && (got_tau / tau - 1.0).abs() <= 0.01,
@@ -275,7 +275,7 @@ fn rtrace_ratio(bin: &Path, dir: &Path, material: &str, sun_theta: f64, transmit
     // miss the 5° polar cap).
     let basis = klems::KlemsBasis::full();
     let per_patch = 64;
-    let mut rng = brtf_model::rng::Rng::new(11, 0);
+    let mut rng = brtf_model::Rng::new(11, 0);
     let mut rays = String::new();
     let mut weights = Vec::new();
     for patch in basis.patches() {
@@ -341,7 +341,7 @@ fn rtrace_ratio(bin: &Path, dir: &Path, material: &str, sun_theta: f64, transmit
         .chunks_exact(24)
         .map(|c| {
             let v = |i: usize| f64::from_ne_bytes(c[8 * i..8 * i + 8].try_into().unwrap());
-            colour::luminance([v(0), v(1), v(2)])
+            brtf_model::luminance([v(0), v(1), v(2)])
         })
         .collect();
     assert_eq!(values.len(), weights.len());

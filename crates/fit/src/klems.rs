@@ -25,7 +25,7 @@
 use crate::data::PatchPairs;
 use crate::recipe::{PatchAveraging, PreparedMeasurement, Recipe, RecipeError};
 use brtf_gonio::klems::{KlemsBasis, KlemsBsdf, Side};
-use brtf_model::rng::Rng;
+use brtf_model::Rng;
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;

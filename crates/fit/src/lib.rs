@@ -29,6 +29,7 @@
 //!
 //! This is the only crate that uses nalgebra and levenberg-marquardt.
 
+mod adequacy;
 mod config;
 mod data;
 mod diagnose;
@@ -44,6 +45,7 @@ mod recipe;
 mod report;
 mod result;
 mod robust;
+mod serde_kind;
 mod set;
 mod solve;
 mod summary;
@@ -53,26 +55,10 @@ mod tests;
 mod uncertainty;
 mod validate;
 
-/// Serialises a material type as its Radiance name.
-pub(crate) mod serde_kind {
-    use brtf_model::MaterialKind;
-    use serde::{Deserialize, Deserializer, Serializer};
-
-    pub fn serialize<S: Serializer>(k: &MaterialKind, s: S) -> Result<S::Ok, S::Error> {
-        s.serialize_str(k.name())
-    }
-
-    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<MaterialKind, D::Error> {
-        String::deserialize(d)?
-            .parse()
-            .map_err(serde::de::Error::custom)
-    }
-}
-
 pub use brtf_gonio::Gate;
 pub use config::{FitConfig, FitError, KnownReflectance, RobustLoss};
 pub use data::{FitSample, GateCount, IncidenceData, PatchPairs, Weighting};
-pub use diagnose::{
+pub use adequacy::{
     Adequacy, ENERGY_TOLERANCE, PEAK_TOLERANCE_DEG, RESIDUAL_KIND_TOLERANCE, ResidualCheck,
 };
 pub use fitter::{fit_global, fit_incidence};

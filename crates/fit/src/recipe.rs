@@ -6,7 +6,7 @@
 //!
 //! In order:
 //! 1. **Colour**: three-channel files hold CIE X, Y, Z; they become
-//!    Radiance RGB ([`brtf_model::colour`]), the colour the models use.
+//!    Radiance RGB ([`brtf_model::xyz_to_rgb`]), the colour the models use.
 //! 2. **Weights**: solid angles of the full layout (the file's Voronoi
 //!    cells, else computed), before any selection; or uniform.
 //! 3. **Conversion** to the fitted quantity ([`Conversion`]): BSDF as is;
@@ -474,7 +474,7 @@ impl Recipe {
         {
             let mut rgb = measurement.clone();
             for sample in &mut rgb.samples {
-                sample.values = brtf_model::colour::xyz_to_rgb(sample.values);
+                sample.values = brtf_model::xyz_to_rgb(sample.values);
             }
             self.convert(&rgb, source)?
         } else {

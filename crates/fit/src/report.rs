@@ -173,7 +173,7 @@ pub struct FitReport {
     pub warnings: Vec<FitWarning>,
     /// Whether the model describes the data (made by [`crate::fit_set`]).
     #[serde(default)]
-    pub adequacy: Option<crate::diagnose::Adequacy>,
+    pub adequacy: Option<crate::adequacy::Adequacy>,
     /// The robust loss's reweighting, when there was one.
     #[serde(default)]
     pub robust: Option<RobustRecord>,
@@ -267,7 +267,7 @@ pub enum FitWarning {
     /// A parameter moves by more than 20% with another residual kind.
     ResidualKindSensitive {
         /// The comparison.
-        check: crate::diagnose::ResidualCheck,
+        check: crate::adequacy::ResidualCheck,
     },
 }
 

@@ -451,7 +451,7 @@ fn diagnose_all(
     data: &[IncidenceData],
     reports: &[FitReport],
     config: &FitConfig,
-) -> Vec<Option<diagnose::Adequacy>> {
+) -> Vec<Option<crate::adequacy::Adequacy>> {
     inputs
         .par_iter()
         .zip(data)
@@ -467,7 +467,7 @@ fn diagnose_all(
 fn assess(
     reports: &mut [FitReport],
     config: &FitConfig,
-    adequacy: Vec<Option<diagnose::Adequacy>>,
+    adequacy: Vec<Option<crate::adequacy::Adequacy>>,
     others: Vec<Option<FitReport>>,
 ) {
     let other = diagnose::other_residual(config.residual);

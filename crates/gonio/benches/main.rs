@@ -57,13 +57,13 @@ fn geometry(c: &mut Criterion) {
     let projected: Vec<[f64; 2]> = m
         .samples
         .iter()
-        .map(|s| brtf_gonio::solid_angle::project(s.theta_deg, s.phi_deg, s.hemisphere()))
+        .map(|s| brtf_gonio::project(s.theta_deg, s.phi_deg, s.hemisphere()))
         .collect();
     group.bench_function("disk_voronoi_golden_paper_127k", |b| {
-        b.iter(|| brtf_gonio::solid_angle::disk_voronoi_areas(black_box(&projected)))
+        b.iter(|| brtf_gonio::disk_voronoi_areas(black_box(&projected)))
     });
     group.bench_function("disk_voronoi_golden_paper_127k_reference", |b| {
-        b.iter(|| brtf_gonio::solid_angle::reference_disk_voronoi_areas(black_box(&projected)))
+        b.iter(|| brtf_gonio::reference_disk_voronoi_areas(black_box(&projected)))
     });
     // A ring layout of the same size (212 rings x 600 azimuths to 85°):
     // the ring path.
@@ -77,7 +77,7 @@ fn geometry(c: &mut Criterion) {
         b.iter(|| brtf_gonio::compute_solid_angles(black_box(&rings)))
     });
     group.bench_function("solid_angles_rings_127k_voronoi", |b| {
-        b.iter(|| brtf_gonio::solid_angle::voronoi_solid_angles(black_box(&rings)))
+        b.iter(|| brtf_gonio::voronoi_solid_angles(black_box(&rings)))
     });
     group.bench_function("summary_golden_paper_127k", |b| {
         b.iter(|| black_box(&m).summary())

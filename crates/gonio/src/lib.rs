@@ -40,18 +40,18 @@
 //! assert!((dsf.samples[0].values[0] - 2.5 * 30f64.to_radians().cos()).abs() < 1e-12);
 //! ```
 
-pub mod convert;
-pub mod error;
-pub mod integral;
+mod convert;
+mod error;
+mod integral;
 pub mod klems;
-pub mod measurement;
-pub mod read;
-pub mod select;
-pub mod solid_angle;
-pub mod summary;
+mod measurement;
+mod read;
+mod select;
+mod solid_angle;
+mod summary;
 pub mod synth;
 mod synth_limits;
-pub mod write;
+mod write;
 
 pub use convert::{Converted, GRAZING_COS_LIMIT};
 pub use error::{ConvertError, KlemsProblem, ParseErrorKind, ReadError, WriteError};
@@ -66,7 +66,11 @@ pub use read::{
     read_path_as, read_sample_name, read_sample_name_at, read_str,
 };
 pub use select::{DEFAULT_THETA_CAP_DEG, Gate, GateContext, PGII_HOLDER_BAND, Selection};
-pub use solid_angle::{SolidAngleSource, SolidAngles, compute_solid_angles, solid_angles};
+pub use solid_angle::{
+    DISK_RADIUS, DirectionLayout, SolidAngleSource, SolidAngles, compute_solid_angles, detect_layout,
+    disk_voronoi_areas, project, reference_disk_voronoi_areas, solid_angles,
+    voronoi_solid_angles,
+};
 pub use summary::{HemisphereSummary, Peak, Summary};
 pub use synth_limits::MAX_SYNTH_SAMPLES;
 pub use write::{to_mountain_string, to_mpc_string, write_mountain, write_mpc, write_path};

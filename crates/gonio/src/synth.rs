@@ -14,7 +14,7 @@ use crate::measurement::{
     Channels, Incidence, IncidenceOrigin, Measurement, Quantity, Sample, SourceFormat,
 };
 use crate::solid_angle::compute_solid_angles;
-use brtf_model::{Bsdf, Rng, colour, direction};
+use brtf_model::{Bsdf, Rng, direction};
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -315,11 +315,11 @@ pub fn synthesize(spec: &SynthSpec) -> Measurement {
         // XYZ, of the material's Radiance RGB.
         let rgb = mean.map(|m| m / n);
         let values = match spec.channels {
-            Channels::Y => [noisy(colour::luminance(rgb), &mut rng), 0.0, 0.0],
+            Channels::Y => [noisy(brtf_model::luminance(rgb), &mut rng), 0.0, 0.0],
             Channels::Xyz => {
                 let k = 1.0 + instrument.noise_relative * rng.normal();
                 let floor = [rng.normal(), rng.normal(), rng.normal()];
-                let xyz = colour::rgb_to_xyz(rgb);
+                let xyz = brtf_model::rgb_to_xyz(rgb);
                 [0, 1, 2].map(|c| xyz[c] * k + instrument.noise_floor * floor[c])
             }
         };

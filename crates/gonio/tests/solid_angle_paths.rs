@@ -1,11 +1,11 @@
 //! The two solid-angle paths: rings for ring layouts, equal-area Voronoi
-//! cells for the rest. Layout detection on the real pgII scans (scattered)
+//! cells for the rest. DirectionLayout detection on the real pgII scans (scattered)
 //! and on synthetic ring layouts; on ring layouts both paths give the same
 //! totals and the same cells to 1 %.
 
 use std::f64::consts::TAU;
 
-use brtf_gonio::solid_angle::{Layout, detect_layout, voronoi_solid_angles};
+use brtf_gonio::{DirectionLayout, detect_layout, voronoi_solid_angles};
 use brtf_gonio::synth::{GroundTruth, Instrument, SynthSpec, synthesize};
 use brtf_gonio::{Channels, Hemisphere, Incidence, Sample, compute_solid_angles};
 
@@ -71,7 +71,7 @@ fn real_scans_are_scattered_and_keep_the_voronoi_cells() {
     for m in [golden(), layer()] {
         assert_eq!(
             detect_layout(&m.samples),
-            [Some(Layout::Scattered), None],
+            [Some(DirectionLayout::Scattered), None],
             "the pgII scans follow adaptive paths, not rings"
         );
         assert_eq!(
@@ -106,7 +106,7 @@ fn both_paths_agree_on_ring_layouts() {
     ];
     for (name, samples) in layouts {
         let layout = detect_layout(&samples);
-        assert_eq!(layout[0], Some(Layout::Rings), "{name}");
+        assert_eq!(layout[0], Some(DirectionLayout::Rings), "{name}");
         let rings = compute_solid_angles(&samples);
         let voronoi = voronoi_solid_angles(&samples);
         for h in [Hemisphere::Front, Hemisphere::Back] {
@@ -127,7 +127,7 @@ fn staggered_rings_keep_the_total_and_the_mean_cell() {
     // hexagons, the ring cells stay bands; per cell they differ, but the
     // totals agree and both are exact partitions.
     let samples = ring_layout(45, 90, (2.0, 90.0), 0.5, 0.0, false);
-    assert_eq!(detect_layout(&samples)[0], Some(Layout::Rings));
+    assert_eq!(detect_layout(&samples)[0], Some(DirectionLayout::Rings));
     let rings = compute_solid_angles(&samples);
     let voronoi = voronoi_solid_angles(&samples);
     assert!((rings.iter().sum::<f64>() - TAU).abs() < 1e-9);
@@ -168,5 +168,5 @@ fn synthetic_files_take_the_path_their_layout_asks_for() {
     };
     let m = synthesize(&spec);
     let layout = detect_layout(&m.samples);
-    assert_eq!(layout[0], Some(Layout::Scattered));
+    assert_eq!(layout[0], Some(DirectionLayout::Scattered));
 }

@@ -57,7 +57,7 @@ fn noise_free_data_integrates_to_the_model_albedo_within_one_percent() {
             .value;
         let model = albedo(&bsdf, direction(theta, 0.0), 1e-6).rho;
         // The single-channel files hold CIE Y, the luminance.
-        let model = brtf_model::colour::luminance(model);
+        let model = brtf_model::luminance(model);
         // The layout stops at θ_out = 88°; the model integral does not.
         let rel = (data - model).abs() / model;
         eprintln!("metal {args:?} θ_in {theta}: data ρ_dh {data:.5}, model {model:.5}");

@@ -33,18 +33,21 @@ mod albedo;
 mod batch;
 mod batch_gradient;
 mod bsdf;
-pub mod colour;
+mod colour;
 mod degrees;
 mod kind;
 mod material;
 mod options;
-pub mod rng;
+mod rng;
 mod words;
 
 pub use albedo::{Albedo, albedo, gauss_legendre_rule};
 pub use batch::{Directions, RgbBatch, exp_lane};
 pub use batch_gradient::{GeometryBatch, PairTerms};
 pub use bsdf::{Bsdf, Geometry, Gradient, Rgb, ViewSplit};
+pub use colour::{
+    PRIMARIES_XY, WHITE_XY, luminance, rgb_to_xyz, rgb_to_xyz_matrix, xyz_to_rgb, xyz_to_rgb_matrix,
+};
 pub use degrees::{cos_degrees, sin_cos_degrees};
 pub use kind::{MaterialKind, Variant};
 pub use material::{FTINY, MAX_ARGS, Material, ModelError, check_args};

@@ -9,11 +9,11 @@
 //!   The target is 40 ms.
 //! * `plots/write_plots`: the same as `brtf plot` does it, with the file
 //!   read again and rebuilt with the fit's recipe.
-//! * `plots/load`: only the rebuild of the data ([`brtf_plot::prepare::load`],
+//! * `plots/load`: only the rebuild of the data (`brtf_plot::bench::load`,
 //!   the model beside every sample; the nearest-sample grids are made on
 //!   first use, by `write_plots` beside the charts that do not need them).
 //! * `plots/coverage`: the nearest-sample grid of the front disk
-//!   ([`brtf_plot::disk::Coverage`]), which the map and the reflectance
+//!   (`brtf_plot::bench::Coverage`), which the map and the reflectance
 //!   chart share.
 //! * `plots/map_png`, `plots/map_svg`: the residual map alone, on data
 //!   loaded afresh each time (outside the timing; the grid of the front
@@ -22,8 +22,8 @@
 use brtf_fit::{FitConfig, FitSetOptions, NoProgress, Recipe};
 use brtf_gonio::Hemisphere;
 use brtf_model::MaterialKind;
-use brtf_plot::charts::map::MapChart;
-use brtf_plot::{PlotOptions, disk, figure, prepare};
+use brtf_plot::PlotOptions;
+use brtf_plot::bench::{self, MapChart};
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 use std::path::{Path, PathBuf};
@@ -79,42 +79,42 @@ fn plots(c: &mut Criterion) {
         b.iter(|| brtf_plot::write_plots(out.path(), black_box(result), &options).unwrap())
     });
     group.bench_function("load", |b| {
-        b.iter(|| prepare::load(result, 0, "t".into(), out.path(), &[]).unwrap())
+        b.iter(|| bench::load(result, 0, "t".into(), out.path(), &[]).unwrap())
     });
-    let inc = prepare::load(result, 0, "t".into(), out.path(), &[]).unwrap();
+    let inc = bench::load(result, 0, "t".into(), out.path(), &[]).unwrap();
     let (ids, points): (Vec<u32>, Vec<(f64, f64)>) = inc
         .samples
         .iter()
         .enumerate()
         .filter(|(_, s)| s.hemisphere() == Hemisphere::Front)
-        .map(|(k, s)| (k as u32, disk::project(s.dir, Hemisphere::Front)))
+        .map(|(k, s)| (k as u32, bench::project(s.dir, Hemisphere::Front)))
         .unzip();
     group.bench_function("coverage", |b| {
         b.iter(|| {
-            disk::Coverage::new(
+            bench::Coverage::new(
                 black_box(&points),
                 &ids,
-                disk::COVERAGE_SIZE,
-                disk::radius_of(disk::FILL_DEG),
+                bench::COVERAGE_SIZE,
+                bench::radius_of(bench::FILL_DEG),
             )
         })
     });
     group.bench_function("map_png", |b| {
         b.iter_batched(
-            || prepare::load(result, 0, "t".into(), out.path(), &[]).unwrap(),
+            || bench::load(result, 0, "t".into(), out.path(), &[]).unwrap(),
             |inc| {
                 let map = MapChart::new(&inc, "map".into(), 2.0, 0.1);
-                figure::render_png(&map).unwrap()
+                bench::render_png(&map).unwrap()
             },
             criterion::BatchSize::LargeInput,
         )
     });
     group.bench_function("map_svg", |b| {
         b.iter_batched(
-            || prepare::load(result, 0, "t".into(), out.path(), &[]).unwrap(),
+            || bench::load(result, 0, "t".into(), out.path(), &[]).unwrap(),
             |inc| {
                 let map = MapChart::new(&inc, "map".into(), 2.0, 0.1);
-                figure::render_svg(&map).unwrap()
+                bench::render_svg(&map).unwrap()
             },
             criterion::BatchSize::LargeInput,
         )

@@ -317,15 +317,6 @@ pub fn render_files(chart: &impl Chart, dir: &Path) -> Result<Vec<(PathBuf, Vec<
     ])
 }
 
-/// Renders `chart` and writes `<dir>/<name>.svg` and `<dir>/<name>.png`.
-pub fn write_chart(chart: &impl Chart, dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
-    let files = render_files(chart, dir)?;
-    for (path, bytes) in &files {
-        write_atomic(path, bytes)?;
-    }
-    Ok(files.into_iter().map(|(path, _)| path).collect())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -60,7 +60,7 @@ fn rows(result: &FitResult, fit_dir: &Path) -> Result<Vec<PatchRow>, String> {
 
 fn luminance(values: [f64; 3], channels: usize) -> f64 {
     if channels >= 3 {
-        brtf_model::colour::luminance(values)
+        brtf_model::luminance(values)
     } else {
         values[0]
     }

@@ -37,17 +37,26 @@
 //! # Ok::<(), brtf_plot::PlotError>(())
 //! ```
 
-pub mod charts;
-pub mod colour;
-pub mod disk;
+mod charts;
+mod colour;
+mod disk;
 mod error;
-pub mod figure;
-pub mod klems;
-pub mod prepare;
-pub mod report;
+mod figure;
+mod klems;
+mod prepare;
+mod report;
 
 pub use error::PlotError;
 pub use klems::klems_sides_report;
+
+/// The pieces the criterion benches time one by one; not brtf-plot's API.
+#[doc(hidden)]
+pub mod bench {
+    pub use crate::charts::map::MapChart;
+    pub use crate::disk::{COVERAGE_SIZE, Coverage, FILL_DEG, project, radius_of};
+    pub use crate::figure::{render_png, render_svg};
+    pub use crate::prepare::load;
+}
 
 use brtf_fit::{FitResult, PreparedMeasurement};
 use charts::azimuth::AzimuthChart;

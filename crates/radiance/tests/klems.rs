@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use brtf_gonio::klems::{self, KlemsBand, KlemsBasis, KlemsDirection};
-use brtf_model::{Bsdf, EvalOptions, Material, MaterialKind, albedo, colour};
+use brtf_model::{Bsdf, EvalOptions, Material, MaterialKind, albedo};
 use brtf_radiance::export::klems::{KlemsOptions, SolarBand, klems_from_material};
 use brtf_radiance::export::klems_cal::{FUNCTION_NAME, bsdf_function_cal};
 
@@ -40,14 +40,14 @@ fn export_of(material: &Material, options: &KlemsOptions) -> klems::KlemsBsdf {
 /// points uniform in projected solid angle (Klems values are incident-
 /// patch averages, as `bsdf2klems` makes them).
 fn patch_albedo(bsdf: &Bsdf, patch: &klems::KlemsPatch) -> (f64, f64) {
-    let mut rng = brtf_model::rng::Rng::new(5, 0);
+    let mut rng = brtf_model::Rng::new(5, 0);
     let points = patch.stratified_directions(36, &mut rng);
     let (mut rho, mut tau) = (0.0, 0.0);
     for p in &points {
-        let l = klems::model_matrix::light_vector(klems::Side::Front, *p);
+        let l = klems::light_vector(klems::Side::Front, *p);
         let a = albedo(bsdf, l, 1e-6);
-        rho += colour::luminance(a.rho) + colour::luminance(a.rho_spike);
-        tau += colour::luminance(a.tau) + colour::luminance(a.tau_spike);
+        rho += brtf_model::luminance(a.rho) + brtf_model::luminance(a.rho_spike);
+        tau += brtf_model::luminance(a.tau) + brtf_model::luminance(a.tau_spike);
     }
     (rho / 36.0, tau / 36.0)
 }
@@ -114,14 +114,14 @@ fn default_sample_count_is_converged_to_one_percent() {
         let bsdf = Bsdf::new(&material, &EvalOptions::default());
         let bsdfs = vec![bsdf; basis.len()];
         let run = |samples: usize| {
-            let options = klems::model_matrix::SampleOptions {
+            let options = klems::SampleOptions {
                 samples,
                 ..Default::default()
             };
-            klems::model_matrix::side_matrices(&basis, &bsdfs, true, options)
+            klems::side_matrices(&basis, &bsdfs, true, options)
         };
-        let base = run(klems::model_matrix::DEFAULT_SAMPLES);
-        let double = run(2 * klems::model_matrix::DEFAULT_SAMPLES);
+        let base = run(klems::DEFAULT_SAMPLES);
+        let double = run(2 * klems::DEFAULT_SAMPLES);
         let n = basis.len();
         let mut worst: f64 = 0.0;
         for (a, b) in [
@@ -131,7 +131,7 @@ fn default_sample_count_is_converged_to_one_percent() {
                 double.transmission.as_ref().unwrap(),
             ),
         ] {
-            let y = |v: &[f64; 3]| colour::luminance(*v);
+            let y = |v: &[f64; 3]| brtf_model::luminance(*v);
             for i in 0..n {
                 let column_max = (0..n).map(|o| y(&b[o * n + i])).fold(0.0, f64::max);
                 for o in 0..n {
@@ -146,8 +146,8 @@ fn default_sample_count_is_converged_to_one_percent() {
         eprintln!(
             "{}: largest entry change at {} -> {} samples: {:.3} %",
             material.kind(),
-            klems::model_matrix::DEFAULT_SAMPLES,
-            2 * klems::model_matrix::DEFAULT_SAMPLES,
+            klems::DEFAULT_SAMPLES,
+            2 * klems::DEFAULT_SAMPLES,
             100.0 * worst
         );
         assert!(worst <= 0.01, "{}: {worst}", material.kind());

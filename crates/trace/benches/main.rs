@@ -17,10 +17,11 @@
 //! (rtrace traces the same ones).
 
 use brtf_model::{EvalOptions, Material, MaterialKind};
-use brtf_trace::gonio::GonioSetup;
-use brtf_trace::integrator::RayCounts;
-use brtf_trace::sampling::{ReflectionLobe, TransmissionLobe};
-use brtf_trace::{Camera, ImageOptions, Rng, Scene, Settings, Shader, Shape, Source, VirtualGonio};
+use brtf_trace::GonioSetup;
+use brtf_trace::RayCounts;
+use brtf_trace::{ReflectionLobe, TransmissionLobe};
+use brtf_model::Rng;
+use brtf_trace::{Camera, ImageOptions, Scene, Settings, Shader, Shape, Source, VirtualGonio};
 use criterion::{BenchmarkId, Criterion, Throughput};
 use glam::DVec3;
 use std::hint::black_box;
@@ -79,8 +80,8 @@ fn bench_shading(c: &mut Criterion) {
     let mut rng = Rng::new(1, 1);
     let dirs: Vec<(DVec3, DVec3)> = (0..1024)
         .map(|_| {
-            let l = brtf_trace::sampling::cosine_hemisphere(rng.uniform2(), 1.0);
-            let v = brtf_trace::sampling::cosine_hemisphere(rng.uniform2(), 1.0);
+            let l = brtf_trace::cosine_hemisphere(rng.uniform2(), 1.0);
+            let v = brtf_trace::cosine_hemisphere(rng.uniform2(), 1.0);
             (l, v)
         })
         .collect();

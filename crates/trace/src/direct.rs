@@ -22,9 +22,8 @@ use glam::DVec3;
 
 use crate::camera::Camera;
 use crate::frame::Frame;
-use crate::image::ImageOptions;
-use crate::integrator::{RayCounts, Tracer};
-use crate::rng::Rng;
+use crate::integrator::{ImageOptions, RayCounts, Tracer};
+use brtf_model::Rng;
 use crate::sampling::sin_cos_turns;
 use crate::scene::{RAY_EPSILON, Scene, Shape, Source};
 

@@ -23,8 +23,8 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::integrator::{RayCounts, Settings, Tracer};
-use crate::rng::Rng;
-use crate::sampling::{cone_half_angle, one_minus_cos, uniform_cone};
+use brtf_model::Rng;
+use crate::sampling::{cone_half_angle, uniform_cone};
 use crate::scene::{Ray, Scene, Shape, Source};
 use crate::shader::Shader;
 
@@ -370,8 +370,8 @@ pub fn stratified_cells(n: usize, rng: &mut Rng) -> Vec<[f64; 2]> {
 /// CIE XYZ (what the file's colorimetry header says the values are).
 pub fn channel_values(c: Rgb, channels: Channels) -> [f64; 3] {
     match channels {
-        Channels::Y => [brtf_model::colour::luminance(c), 0.0, 0.0],
-        Channels::Xyz => brtf_model::colour::rgb_to_xyz(c),
+        Channels::Y => [brtf_model::luminance(c), 0.0, 0.0],
+        Channels::Xyz => brtf_model::rgb_to_xyz(c),
     }
 }
 
@@ -485,7 +485,3 @@ pub fn cone_average(
     std::array::from_fn(|k| num[k] / (den * wsum_v))
 }
 
-/// True when `dir` lies inside the cone of half-angle `a` around `axis`.
-pub fn in_cone(axis: DVec3, a: f64, dir: DVec3) -> bool {
-    1.0 - axis.dot(dir) <= one_minus_cos(a)
-}

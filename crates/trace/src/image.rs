@@ -13,40 +13,10 @@ use std::time::{Duration, Instant};
 use crate::camera::Camera;
 use crate::direct::DirectRows;
 use crate::hdr::Picture;
-use crate::integrator::{RayCounts, Settings, Tracer};
-use crate::rng::Rng;
+use crate::integrator::{ImageOptions, RayCounts, Tracer};
+use brtf_model::Rng;
 use crate::scene::Scene;
 
-/// How to render a picture.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ImageOptions {
-    /// Width in pixels.
-    pub width: usize,
-    /// Height in pixels.
-    pub height: usize,
-    /// Camera rays per pixel.
-    pub samples: u32,
-    /// Jitter the rays inside each pixel (else: pixel centres, like
-    /// `rpict -pj 0`; then all samples share the centre).
-    pub jitter: bool,
-    /// Random seed.
-    pub seed: u64,
-    /// Sample counts of the integrator.
-    pub settings: Settings,
-}
-
-impl Default for ImageOptions {
-    fn default() -> Self {
-        ImageOptions {
-            width: 320,
-            height: 240,
-            samples: 16,
-            jitter: true,
-            seed: 1,
-            settings: Settings::default(),
-        }
-    }
-}
 
 /// A rendered picture and what it cost.
 #[derive(Debug, Clone)]
@@ -115,7 +85,7 @@ pub fn render(scene: &Scene, camera: &Camera, options: &ImageOptions) -> Rendere
 
 /// Luminance-like brightness of an RGB value (Radiance's `bright()`).
 pub fn brightness(c: [f32; 3]) -> f64 {
-    brtf_model::colour::luminance(c.map(f64::from))
+    brtf_model::luminance(c.map(f64::from))
 }
 
 /// The exposure that maps the 97th percentile of the non-zero pixel

@@ -20,7 +20,7 @@
 use brtf_model::Rgb;
 use glam::DVec3;
 
-use crate::rng::Rng;
+use brtf_model::Rng;
 use crate::sampling::cosine_hemisphere;
 use crate::scene::{Hit, PreparedSource, RAY_EPSILON, Ray, Scene};
 
@@ -454,5 +454,36 @@ impl Tracer<'_> {
         source: usize,
     ) -> Option<(crate::frame::Frame, f64, f64)> {
         self.sources[source].distant()
+    }
+}
+
+/// How to render a picture.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImageOptions {
+    /// Width in pixels.
+    pub width: usize,
+    /// Height in pixels.
+    pub height: usize,
+    /// Camera rays per pixel.
+    pub samples: u32,
+    /// Jitter the rays inside each pixel (else: pixel centres, like
+    /// `rpict -pj 0`; then all samples share the centre).
+    pub jitter: bool,
+    /// Random seed.
+    pub seed: u64,
+    /// Sample counts of the integrator.
+    pub settings: Settings,
+}
+
+impl Default for ImageOptions {
+    fn default() -> Self {
+        ImageOptions {
+            width: 320,
+            height: 240,
+            samples: 16,
+            jitter: true,
+            seed: 1,
+            settings: Settings::default(),
+        }
     }
 }

@@ -36,25 +36,35 @@
 //! stream seeded by `(seed, pixel or direction index)`, so results are
 //! deterministic and independent of the thread count.
 
-pub mod camera;
-pub mod check;
+mod camera;
+mod check;
 mod direct;
-pub mod frame;
-pub mod gonio;
+mod frame;
+mod gonio;
 pub mod hdr;
-pub mod image;
-pub mod integrator;
-pub use brtf_model::rng;
-pub mod sampling;
-pub mod scene;
-pub mod scene_spec;
-pub mod shader;
+mod image;
+mod integrator;
+mod sampling;
+mod scene;
+mod scene_spec;
+mod shader;
 
 pub use camera::Camera;
-pub use gonio::{GonioError, GonioSetup, GonioValue, VirtualGonio, cone_average};
-pub use image::{ImageOptions, Rendered, render};
-pub use integrator::{RayCounts, Settings, Tracer};
-pub use rng::Rng;
+pub use check::{CheckOptions, CheckReport, check_fit};
+pub use frame::Frame;
+pub use gonio::{
+    Aperture, GonioError, GonioSetup, GonioValue, VirtualGonio, aperture_solid_angle,
+    cone_average, grid, measurement_from,
+};
+pub use image::{Rendered, auto_exposure, render, write_png};
+pub use integrator::{ImageOptions, RayCounts, Settings, Tracer};
+pub use sampling::{
+    ReflectionLobe, TransmissionLobe, cosine_hemisphere, cosine_hemisphere_pdf, one_minus_cos,
+    uniform_cone, uniform_cone_pdf,
+};
 pub use scene::{Ray, Scene, Shape, Source};
-pub use scene_spec::{LightKind, LightSpec, SceneKind, SceneSpec, SceneSpecError, ViewSpec};
+pub use scene_spec::{
+    BALL_CENTER, FLOOR_RADIUS, LightKind, LightSpec, MATERIAL_NAME, SceneKind, SceneSpec,
+    SceneSpecError, ViewSpec,
+};
 pub use shader::{Shader, ShaderError};

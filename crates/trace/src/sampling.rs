@@ -258,7 +258,7 @@ impl TransmissionLobe {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::rng::Rng;
+    use brtf_model::Rng;
 
     /// Against libm's `sin_cos(2πu)` on 10⁶ random turns, every eighth of
     /// a turn and the ends: within 1e-15 absolute (a few ulp; libm's

@@ -432,7 +432,7 @@ mod tests {
                 radiance: [1.0; 3],
             },
         ];
-        let mut rng = crate::rng::Rng::new(3, 4);
+        let mut rng = brtf_model::Rng::new(3, 4);
         for source in &sources {
             let prepared = PreparedSource::new(source);
             for _ in 0..1000 {
@@ -450,7 +450,7 @@ mod tests {
             radius: 2.0,
             radiance: [1.0; 3],
         };
-        let mut rng = crate::rng::Rng::new(0, 0);
+        let mut rng = brtf_model::Rng::new(0, 0);
         for _ in 0..100 {
             let s = src.sample(DVec3::ZERO, rng.uniform2()).unwrap();
             let p = s.dir * s.distance;

@@ -18,7 +18,7 @@ use glam::DVec3;
 use std::f64::consts::PI;
 
 use crate::camera::Camera;
-use crate::image::ImageOptions;
+use crate::integrator::ImageOptions;
 use crate::integrator::Settings;
 use crate::scene::{Scene, Shape, Source};
 use crate::shader::Shader;

@@ -7,7 +7,8 @@
 
 use crate::common::{mat, zoo};
 use brtf_model::{Bsdf, EvalOptions, MaterialKind, albedo};
-use brtf_trace::{Ray, RayCounts, Rng, Scene, Settings, Shader, Shape, Tracer};
+use brtf_model::Rng;
+use brtf_trace::{Ray, RayCounts, Scene, Settings, Shader, Shape, Tracer};
 use glam::DVec3;
 
 fn furnace_radiance(shader: Shader, v: DVec3, background: f64, rays: u32) -> ([f64; 3], RayCounts) {

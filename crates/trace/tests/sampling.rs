@@ -11,9 +11,9 @@
 
 use crate::common::chi2_p_value;
 use brtf_model::gauss_legendre_rule as gauss_legendre;
-use brtf_trace::Rng;
-use brtf_trace::frame::Frame;
-use brtf_trace::sampling::{
+use brtf_model::Rng;
+use brtf_trace::Frame;
+use brtf_trace::{
     ReflectionLobe, TransmissionLobe, cosine_hemisphere, cosine_hemisphere_pdf, uniform_cone,
     uniform_cone_pdf,
 };
@@ -261,7 +261,7 @@ fn cosine_and_cone_samplers_match_their_pdfs() {
         |d| uniform_cone_pdf(axis, a, d),
         axis,
         // Puts the cone's edge on a bin boundary (x = 20/24 of the range).
-        brtf_trace::sampling::one_minus_cos(a) / 6f64.ln(),
+        brtf_trace::one_minus_cos(a) / 6f64.ln(),
         None,
         401,
     );

@@ -6,8 +6,8 @@
 
 use crate::common::mat;
 use brtf_model::{EvalOptions, MaterialKind};
-use brtf_trace::gonio::{Aperture, GonioError, GonioSetup, aperture_solid_angle, grid};
-use brtf_trace::scene_spec::{BALL_CENTER, FLOOR_RADIUS};
+use brtf_trace::{Aperture, GonioError, GonioSetup, aperture_solid_angle, grid};
+use brtf_trace::{BALL_CENTER, FLOOR_RADIUS};
 use brtf_trace::{
     LightKind, SceneKind, SceneSpec, SceneSpecError, Settings, Shader, Shape, Source,
 };

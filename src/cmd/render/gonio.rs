@@ -4,7 +4,7 @@ use super::SampleMaterial;
 use crate::cmd::shared::{csv_stdout, with_jobs, words, write_numbers};
 use anyhow::{Context, Result, bail};
 use brtf_gonio::{Channels, Measurement, SourceFormat};
-use brtf_trace::gonio::{
+use brtf_trace::{
     Aperture, GonioSetup, VirtualGonio, aperture_solid_angle, grid, measurement_from,
 };
 use clap::Args;

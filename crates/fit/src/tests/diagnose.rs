@@ -5,10 +5,10 @@
 
 use super::{measurement, report, ring_directions};
 use crate::config::FitConfig;
-use crate::diagnose::{
+use crate::adequacy::{
     Adequacy, ENERGY_TOLERANCE, PEAK_TOLERANCE_DEG, RESIDUAL_KIND_TOLERANCE, ResidualCheck,
-    compare, diagnose, other_residual, warnings,
 };
+use crate::diagnose::{compare, diagnose, other_residual, warnings};
 use crate::problem::ResidualKind;
 use crate::recipe::{ColourConversion, PreparedMeasurement, Recipe, ScaleRule, WeightRule};
 use crate::report::FitWarning;

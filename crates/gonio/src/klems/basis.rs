@@ -10,7 +10,7 @@
 
 use std::f64::consts::PI;
 
-use brtf_model::rng::Rng;
+use brtf_model::Rng;
 use glam::DVec3;
 use serde::Serialize;
 

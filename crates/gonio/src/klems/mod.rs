@@ -18,10 +18,10 @@
 //! sits at φ + 180°; outgoing patch (θ, φ) points at (θ, φ), on the
 //! reflection or the transmission side.
 
-pub mod basis;
-pub mod model_matrix;
+mod basis;
+mod model_matrix;
 mod read;
-pub mod write;
+mod write;
 
 use std::fmt;
 
@@ -32,6 +32,9 @@ use crate::measurement::{
 };
 
 pub use basis::{BasisSize, KlemsBasis, KlemsPatch, KlemsRing};
+pub use model_matrix::{
+    DEFAULT_SAMPLES, SampleOptions, SideMatrices, band_values, light_vector, side_matrices,
+};
 pub use read::{read_bytes, read_path, read_str};
 pub use write::{KlemsWriteBlock, KlemsWriteHeader, to_klems_xml};
 

@@ -15,7 +15,7 @@
 //! [`light_vector`] and [`view_vector`] say how a point of a patch
 //! becomes brtf's light and view vectors for either side.
 
-use brtf_model::rng::Rng;
+use brtf_model::Rng;
 use brtf_model::{Bsdf, Rgb};
 use glam::DVec3;
 use rayon::prelude::*;
@@ -272,7 +272,7 @@ pub fn band_values(rgb: &[Rgb], band: &super::KlemsBand) -> Option<Vec<f64>> {
     };
     Some(
         rgb.iter()
-            .map(|&v| brtf_model::colour::rgb_to_xyz(v)[channel])
+            .map(|&v| brtf_model::rgb_to_xyz(v)[channel])
             .collect(),
     )
 }

@@ -7,13 +7,13 @@
 //! hemisphere at a time, and picks one of two exact partitions of the
 //! hemisphere by looking at the layout ([`detect_layout`]):
 //!
-//! * **Rings** ([`Layout::Rings`], module `rings`): the directions lie on
+//! * **Rings** ([`DirectionLayout::Rings`], module `rings`): the directions lie on
 //!   rings of (near-)constant θ about the hemisphere's normal, as in a
 //!   regular (θ, φ) scan. Each sample owns the spherical cell between the
 //!   mid-θ of its ring and the neighbouring rings, and between the mid-φ of
 //!   its neighbours on the ring. The cells are exact on the sphere, cost one
 //!   sort, and sum to 2π.
-//! * **Scattered** ([`Layout::Scattered`], module `voronoi`): anything else,
+//! * **Scattered** ([`DirectionLayout::Scattered`], module `voronoi`): anything else,
 //!   such as the adaptive paths of the real pgII scans. Each sample owns
 //!   its equal-area Voronoi cell (Lambert projection, Delaunay
 //!   triangulation, cells clipped to the disk), which also sums to 2π.
@@ -34,7 +34,7 @@ use serde::{Deserialize, Serialize};
 use crate::measurement::{Hemisphere, Measurement, Sample};
 
 pub use voronoi::{
-    DISK_RADIUS, disk_polygon_area, disk_voronoi_areas, project, reference_disk_voronoi_areas,
+    DISK_RADIUS, disk_voronoi_areas, project, reference_disk_voronoi_areas,
 };
 
 /// Where a set of solid angles came from.
@@ -59,7 +59,7 @@ pub struct SolidAngles {
 
 /// How the directions of one hemisphere are laid out.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Layout {
+pub enum DirectionLayout {
     /// Rings of near-constant θ about the hemisphere's normal.
     Rings,
     /// Anything else.
@@ -128,7 +128,7 @@ pub fn voronoi_solid_angles(samples: &[Sample]) -> Vec<f64> {
 
 /// The layout of each hemisphere's valid directions, front then back
 /// (`None` for a hemisphere without samples).
-pub fn detect_layout(samples: &[Sample]) -> [Option<Layout>; 2] {
+pub fn detect_layout(samples: &[Sample]) -> [Option<DirectionLayout>; 2] {
     let [front, back] = both_hemispheres(samples);
     [(Hemisphere::Front, front), (Hemisphere::Back, back)].map(|(hemisphere, members)| {
         if members.is_empty() {
@@ -136,9 +136,9 @@ pub fn detect_layout(samples: &[Sample]) -> [Option<Layout>; 2] {
         } else if rings::ring_areas_of(members.len(), |k| members.direction(k), hemisphere)
             .is_some()
         {
-            Some(Layout::Rings)
+            Some(DirectionLayout::Rings)
         } else {
-            Some(Layout::Scattered)
+            Some(DirectionLayout::Scattered)
         }
     })
 }

@@ -17,7 +17,7 @@
 use std::path::{Path, PathBuf};
 
 use brtf_fit::{FitResult, azimuth_from_u};
-use brtf_gonio::klems::model_matrix::{self, SampleOptions, SideMatrices};
+use brtf_gonio::klems::{SampleOptions, SideMatrices, band_values, side_matrices};
 use brtf_gonio::klems::{
     KlemsBand, KlemsBasis, KlemsDirection, KlemsWriteBlock, KlemsWriteHeader, Side, to_klems_xml,
 };
@@ -360,7 +360,7 @@ fn build(
     for (side, model) in &sides {
         let matrices = match computed.first() {
             Some((_, front)) if model.same_as_front => front.clone(),
-            _ => model_matrix::side_matrices(
+            _ => side_matrices(
                 basis,
                 &model.bsdfs,
                 model.transmitting,
@@ -393,7 +393,7 @@ fn build(
             blocks.push(KlemsWriteBlock {
                 band: band.clone(),
                 direction: *direction,
-                values: model_matrix::band_values(rgb, band).expect("Y, X or Z"),
+                values: band_values(rgb, band).expect("Y, X or Z"),
             });
         }
     }
@@ -409,7 +409,7 @@ fn build(
                 blocks.push(KlemsWriteBlock {
                     band: KlemsBand::Solar,
                     direction: *direction,
-                    values: model_matrix::band_values(rgb, &KlemsBand::Visible).expect("Y"),
+                    values: band_values(rgb, &KlemsBand::Visible).expect("Y"),
                 });
             }
         }
@@ -434,7 +434,7 @@ fn build(
                 ));
             }
             // One static material: the same matrices for both sides.
-            let m = model_matrix::side_matrices(
+            let m = side_matrices(
                 basis,
                 &vec![bsdf; basis.len()],
                 transmitting,
@@ -445,7 +445,7 @@ fn build(
                     blocks.push(KlemsWriteBlock {
                         band: KlemsBand::Solar,
                         direction,
-                        values: model_matrix::band_values(&rgb, &KlemsBand::Visible).expect("Y"),
+                        values: band_values(&rgb, &KlemsBand::Visible).expect("Y"),
                     });
                 }
             }

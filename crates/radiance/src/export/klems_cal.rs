@@ -17,7 +17,7 @@
 //! as rtrace and brtf-model do. Roughness-0 (delta) parts cannot be a
 //! function and the anisotropic types are not written: both are refused.
 
-use brtf_model::{Material, MaterialKind, colour};
+use brtf_model::{Material, MaterialKind};
 
 /// The function's name in the written file.
 pub const FUNCTION_NAME: &str = "brtf_bsdf";
@@ -37,7 +37,7 @@ pub fn bsdf_function_cal(material: &Material) -> Result<String, String> {
             "{kind} with roughness {rough}: a roughness-0 (delta) part cannot be a function"
         ));
     }
-    let y = |rgb: [f64; 3]| colour::luminance(rgb);
+    let y = |rgb: [f64; 3]| brtf_model::luminance(rgb);
     let c_y = y(material.color());
     let spec = args[3];
     let (trans, tspec) = match kind {

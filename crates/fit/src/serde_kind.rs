@@ -1,0 +1,14 @@
+//! Serialises a material type as its Radiance name (`#[serde(with)]`).
+
+use brtf_model::MaterialKind;
+use serde::{Deserialize, Deserializer, Serializer};
+
+pub fn serialize<S: Serializer>(k: &MaterialKind, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_str(k.name())
+}
+
+pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<MaterialKind, D::Error> {
+    String::deserialize(d)?
+        .parse()
+        .map_err(serde::de::Error::custom)
+}
