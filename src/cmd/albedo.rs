@@ -7,7 +7,7 @@ use clap::Args;
 use std::io::{BufWriter, Write};
 
 #[derive(Args, Debug)]
-pub struct AlbedoArgs {
+pub(crate) struct AlbedoArgs {
     #[command(flatten)]
     pub material: MaterialArgs,
     /// Incident polar angles θ_in in degrees, comma-separated.
@@ -26,7 +26,7 @@ pub struct AlbedoArgs {
     pub tolerance: f64,
 }
 
-pub fn run(args: AlbedoArgs) -> Result<()> {
+pub(crate) fn run(args: AlbedoArgs) -> Result<()> {
     for &t in &args.theta_in {
         brtf_model::check_incidence(t, args.phi_in)?;
     }

@@ -9,7 +9,7 @@ use clap::Args;
 use std::path::PathBuf;
 
 #[derive(Args, Debug)]
-pub struct CheckArgs {
+pub(crate) struct CheckArgs {
     /// The fit folder (holds fit.json).
     pub dir: PathBuf,
     /// Rays per detector direction.
@@ -47,7 +47,7 @@ pub struct CheckArgs {
     pub jobs: Option<usize>,
 }
 
-pub fn run(args: CheckArgs) -> Result<()> {
+pub(crate) fn run(args: CheckArgs) -> Result<()> {
     let apex = |a: Option<f64>| a.map(brtf_model::cone_solid_angle);
     let options = CheckOptions {
         samples: args.samples,

@@ -8,7 +8,7 @@ use clap::Args;
 use std::io::BufRead;
 
 #[derive(Args, Debug)]
-pub struct EvalArgs {
+pub(crate) struct EvalArgs {
     #[command(flatten)]
     pub material: MaterialArgs,
     /// Incident polar angle θ_in in degrees (towards the light).
@@ -19,7 +19,7 @@ pub struct EvalArgs {
     pub phi_in: f64,
 }
 
-pub fn run(args: EvalArgs) -> Result<()> {
+pub(crate) fn run(args: EvalArgs) -> Result<()> {
     brtf_model::check_incidence(args.theta_in, args.phi_in)?;
     let bsdf = args.material.bsdf()?;
     let l = direction(args.theta_in, args.phi_in);

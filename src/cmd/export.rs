@@ -14,7 +14,7 @@ use clap::Args;
 use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
-pub struct ExportArgs {
+pub(crate) struct ExportArgs {
     /// The fit folder (holds fit.json, or front/fit.json and back/fit.json).
     #[arg(required_unless_present = "material")]
     pub dir: Option<PathBuf>,
@@ -40,7 +40,7 @@ pub struct ExportArgs {
 
 /// `--klems` and its options.
 #[derive(Args, Debug)]
-pub struct KlemsArgs {
+pub(crate) struct KlemsArgs {
     /// Write `<name>.xml`, a Klems BSDF XML file, in this basis (default
     /// full) instead of the Radiance materials.
     #[arg(long, value_name = "BASIS", num_args = 0..=1, default_missing_value = "full",
@@ -81,7 +81,7 @@ pub struct KlemsArgs {
     pub device_type: String,
 }
 
-pub fn run(args: ExportArgs) -> Result<()> {
+pub(crate) fn run(args: ExportArgs) -> Result<()> {
     if let Some(basis) = args.klems.klems {
         return run_klems(&args, basis);
     }

@@ -15,7 +15,7 @@ use clap::Args;
 use serde::Serialize;
 
 #[derive(Args, Debug)]
-pub struct InfoArgs {
+pub(crate) struct InfoArgs {
     /// Measurement files (.mpc, pab-opto Mountain or Klems BSDF XML).
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
@@ -39,7 +39,7 @@ enum Entry {
     Klems(FileSummary<brtf_gonio::klems::KlemsInfo>),
 }
 
-pub fn run(args: InfoArgs) -> anyhow::Result<()> {
+pub(crate) fn run(args: InfoArgs) -> anyhow::Result<()> {
     let mut out = crate::cmd::output::stdout();
     write_report(&args, &mut out)?;
     Ok(out.flush()?)

@@ -7,7 +7,7 @@ use clap::Args;
 use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug, Clone)]
-pub struct MaterialArgs {
+pub(crate) struct MaterialArgs {
     /// Radiance file holding the material primitive(s).
     #[arg(long, value_name = "M.rad")]
     pub material: PathBuf,
@@ -26,7 +26,7 @@ pub struct MaterialArgs {
 
 /// The formula options of a material: `--variant` and `--fresnel-k`.
 #[derive(Args, Debug, Clone, Copy)]
-pub struct FormulaArgs {
+pub(crate) struct FormulaArgs {
     /// Formula set: radiance (current rtrace), manual2004 or ward1992.
     #[arg(long, value_parser = words::<Variant>(), default_value_t = Variant::Radiance)]
     pub variant: Variant,
@@ -38,7 +38,7 @@ pub struct FormulaArgs {
 
 impl FormulaArgs {
     /// Default evaluation options with this formula set.
-    pub fn options(&self) -> EvalOptions {
+    pub(crate) fn options(&self) -> EvalOptions {
         EvalOptions {
             variant: self.variant,
             fresnel_k: self.fresnel_k,
@@ -48,7 +48,7 @@ impl FormulaArgs {
 }
 
 /// Reads a Radiance file and picks the material `name` (or its only one).
-pub fn load_material(path: &Path, name: Option<&str>) -> Result<(String, Material)> {
+pub(crate) fn load_material(path: &Path, name: Option<&str>) -> Result<(String, Material)> {
     let shown = path.display().to_string();
     let text = std::fs::read_to_string(path)
         .with_context(|| format!("cannot read material file {shown}"))?;
@@ -58,11 +58,11 @@ pub fn load_material(path: &Path, name: Option<&str>) -> Result<(String, Materia
 
 impl MaterialArgs {
     /// Reads the file and picks the material.
-    pub fn load(&self) -> Result<(String, Material)> {
+    pub(crate) fn load(&self) -> Result<(String, Material)> {
         load_material(&self.material, self.name.as_deref())
     }
 
-    pub fn options(&self) -> Result<EvalOptions> {
+    pub(crate) fn options(&self) -> Result<EvalOptions> {
         let options = EvalOptions {
             source_omega: self.source_omega,
             flat: !self.curved,
@@ -72,7 +72,7 @@ impl MaterialArgs {
         Ok(options)
     }
 
-    pub fn bsdf(&self) -> Result<Bsdf> {
+    pub(crate) fn bsdf(&self) -> Result<Bsdf> {
         let (_, material) = self.load()?;
         Ok(Bsdf::new(&material, &self.options()?))
     }

@@ -1,13 +1,13 @@
 //! One module per subcommand.
-pub mod albedo;
-pub mod check;
-pub mod eval;
-pub mod export;
-pub mod fit;
-pub mod info;
-pub mod material;
-pub mod output;
-pub mod plot;
-pub mod render;
-pub mod shared;
-pub mod synth;
+pub(crate) mod albedo;
+pub(crate) mod check;
+pub(crate) mod eval;
+pub(crate) mod export;
+pub(crate) mod fit;
+pub(crate) mod info;
+pub(crate) mod material;
+pub(crate) mod output;
+pub(crate) mod plot;
+pub(crate) mod render;
+pub(crate) mod shared;
+pub(crate) mod synth;

@@ -9,7 +9,7 @@ use std::path::Path;
 
 /// Writes `bytes` to `path` atomically (same-folder temporary + rename),
 /// creating its folder when missing.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     if let Some(folder) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
         brtf_io::ensure_folder(folder)?;
     }
@@ -18,10 +18,10 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
 
 /// Standard output whose errors name it and keep their kind (so that
 /// [`is_broken_pipe`] can tell a reader that left from a failure).
-pub struct Stdout(std::io::StdoutLock<'static>);
+pub(crate) struct Stdout(std::io::StdoutLock<'static>);
 
 /// The locked standard output.
-pub fn stdout() -> Stdout {
+pub(crate) fn stdout() -> Stdout {
     Stdout(std::io::stdout().lock())
 }
 
@@ -39,7 +39,7 @@ impl Write for Stdout {
 }
 
 /// Prints `text` to standard output and flushes it.
-pub fn print(text: &str) -> Result<()> {
+pub(crate) fn print(text: &str) -> Result<()> {
     let mut out = stdout();
     out.write_all(text.as_bytes())?;
     Ok(out.flush()?)
@@ -47,7 +47,7 @@ pub fn print(text: &str) -> Result<()> {
 
 /// Whether `err` comes from writing into a pipe whose reader has gone
 /// (`brtf … | head -1`).
-pub fn is_broken_pipe(err: &anyhow::Error) -> bool {
+pub(crate) fn is_broken_pipe(err: &anyhow::Error) -> bool {
     err.chain().any(|cause| {
         cause
             .downcast_ref::<std::io::Error>()

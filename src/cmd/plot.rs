@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 #[derive(Args, Debug)]
-pub struct PlotArgs {
+pub(crate) struct PlotArgs {
     /// Fit folder (holds fit.json); plots go to DIR/plots, the report to DIR/report.html.
     pub dir: PathBuf,
     /// Another folder to look in for measurement files recorded with a relative path (repeatable).
@@ -23,7 +23,7 @@ pub struct PlotArgs {
     pub plane_tolerance: Option<f64>,
 }
 
-pub fn run(args: PlotArgs) -> Result<()> {
+pub(crate) fn run(args: PlotArgs) -> Result<()> {
     if let Some(r) = args.ratio {
         anyhow::ensure!(
             r.is_finite() && r > 1.0,

@@ -7,7 +7,7 @@ use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 
 /// clap's parser for a library enum's words ([`OptionWords`]): `--help`
 /// lists them, and older spellings are read as aliases.
-pub fn words<T>() -> impl TypedValueParser<Value = T>
+pub(crate) fn words<T>() -> impl TypedValueParser<Value = T>
 where
     T: OptionWords + std::str::FromStr<Err = WordError> + Clone + Send + Sync,
 {
@@ -19,7 +19,7 @@ where
 }
 
 /// Runs `f` on a rayon pool of `jobs` threads (or the global pool).
-pub fn with_jobs<T: Send>(jobs: Option<usize>, f: impl FnOnce() -> T + Send) -> Result<T> {
+pub(crate) fn with_jobs<T: Send>(jobs: Option<usize>, f: impl FnOnce() -> T + Send) -> Result<T> {
     match jobs {
         Some(n) => {
             let pool = rayon::ThreadPoolBuilder::new()
@@ -33,13 +33,16 @@ pub fn with_jobs<T: Send>(jobs: Option<usize>, f: impl FnOnce() -> T + Send) -> 
 }
 
 /// A CSV writer on stdout (buffered; flush it at the end).
-pub fn csv_stdout() -> csv::Writer<crate::cmd::output::Stdout> {
+pub(crate) fn csv_stdout() -> csv::Writer<crate::cmd::output::Stdout> {
     csv::Writer::from_writer(crate::cmd::output::stdout())
 }
 
 /// Writes one CSV row of numbers, each as Rust's `{}` prints it (the
 /// shortest text that reads back as the same `f64`).
-pub fn write_numbers<W: std::io::Write>(out: &mut csv::Writer<W>, row: &[f64]) -> Result<()> {
+pub(crate) fn write_numbers<W: std::io::Write>(
+    out: &mut csv::Writer<W>,
+    row: &[f64],
+) -> Result<()> {
     out.write_record(row.iter().map(f64::to_string))?;
     Ok(())
 }

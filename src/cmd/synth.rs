@@ -10,7 +10,7 @@ use clap::Args;
 use std::path::PathBuf;
 
 #[derive(Args, Debug)]
-pub struct SynthArgs {
+pub(crate) struct SynthArgs {
     /// Ground truth: a brtf-model material (with --name, --variant, ...).
     #[arg(long, value_name = "M.rad", conflicts_with = "ggx")]
     pub material: Option<PathBuf>,
@@ -80,7 +80,7 @@ pub struct SynthArgs {
 
 /// The model options of `--material` (same spellings as `brtf eval`).
 #[derive(Args, Debug)]
-pub struct SynthModelArgs {
+pub(crate) struct SynthModelArgs {
     /// Which material in the file.
     #[arg(long)]
     pub name: Option<String>,
@@ -88,7 +88,7 @@ pub struct SynthModelArgs {
     pub formula: FormulaArgs,
 }
 
-pub fn run(args: SynthArgs) -> Result<()> {
+pub(crate) fn run(args: SynthArgs) -> Result<()> {
     let truth = match (&args.material, &args.ggx) {
         (Some(path), None) => {
             let material = MaterialArgs {

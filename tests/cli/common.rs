@@ -5,11 +5,11 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
 /// Path of the binary under test.
-pub const BRTF: &str = env!("CARGO_BIN_EXE_brtf");
+pub(crate) const BRTF: &str = env!("CARGO_BIN_EXE_brtf");
 
 /// The outcome of one `brtf` run.
 #[derive(Debug)]
-pub struct Run {
+pub(crate) struct Run {
     pub success: bool,
     pub code: Option<i32>,
     pub stdout: String,
@@ -21,14 +21,14 @@ pub struct Run {
 impl Run {
     /// Panics (with the whole run in the message) unless the run succeeded.
     #[track_caller]
-    pub fn ok(self) -> String {
+    pub(crate) fn ok(self) -> String {
         assert!(self.success, "expected success, got {self}");
         self.stdout
     }
 
     /// Panics unless the run failed with a non-zero exit code; returns stderr.
     #[track_caller]
-    pub fn err(self) -> String {
+    pub(crate) fn err(self) -> String {
         assert!(!self.success, "expected failure, got {self}");
         assert!(
             matches!(self.code, Some(c) if c != 0),
@@ -53,7 +53,7 @@ impl std::fmt::Display for Run {
 }
 
 /// Runs `brtf args...` with `stdin` as its standard input.
-pub fn brtf<S: AsRef<str>>(args: &[S], stdin: &str) -> Run {
+pub(crate) fn brtf<S: AsRef<str>>(args: &[S], stdin: &str) -> Run {
     let args: Vec<&str> = args.iter().map(AsRef::as_ref).collect();
     let mut child = Command::new(BRTF)
         .args(&args)
@@ -82,7 +82,7 @@ pub fn brtf<S: AsRef<str>>(args: &[S], stdin: &str) -> Run {
 
 /// A CSV table with a header and numeric rows.
 #[derive(Debug, Clone)]
-pub struct Csv {
+pub(crate) struct Csv {
     pub header: Vec<String>,
     pub rows: Vec<Vec<f64>>,
 }
@@ -90,7 +90,7 @@ pub struct Csv {
 impl Csv {
     /// Index of a column by name.
     #[track_caller]
-    pub fn col(&self, name: &str) -> usize {
+    pub(crate) fn col(&self, name: &str) -> usize {
         self.header
             .iter()
             .position(|h| h == name)
@@ -98,7 +98,7 @@ impl Csv {
     }
 
     /// The values of one column.
-    pub fn column(&self, name: &str) -> Vec<f64> {
+    pub(crate) fn column(&self, name: &str) -> Vec<f64> {
         let i = self.col(name);
         self.rows.iter().map(|r| r[i]).collect()
     }
@@ -107,7 +107,7 @@ impl Csv {
 /// Parses CSV output: a header line, then rows of numbers with as many
 /// fields as the header.
 #[track_caller]
-pub fn parse_csv(text: &str) -> Csv {
+pub(crate) fn parse_csv(text: &str) -> Csv {
     let mut lines = text.lines();
     let header: Vec<String> = lines
         .next()
@@ -139,7 +139,7 @@ pub fn parse_csv(text: &str) -> Csv {
 }
 
 /// A fresh temporary directory (removed when dropped).
-pub fn temp_dir() -> tempfile::TempDir {
+pub(crate) fn temp_dir() -> tempfile::TempDir {
     tempfile::Builder::new()
         .prefix("brtf-cli-test")
         .tempdir()
@@ -147,38 +147,38 @@ pub fn temp_dir() -> tempfile::TempDir {
 }
 
 /// Writes `text` to `dir/name` and returns the path.
-pub fn write_file(dir: &Path, name: &str, text: &str) -> PathBuf {
+pub(crate) fn write_file(dir: &Path, name: &str, text: &str) -> PathBuf {
     let path = dir.join(name);
     std::fs::write(&path, text).unwrap_or_else(|e| panic!("write {}: {e}", path.display()));
     path
 }
 
 /// A path as a `&str` (temp dirs and the repo are UTF-8 here).
-pub fn s(path: &Path) -> &str {
+pub(crate) fn s(path: &Path) -> &str {
     path.to_str().expect("UTF-8 path")
 }
 
 /// Path of a file under the repository root.
-pub fn repo_path(relative: &str) -> PathBuf {
+pub(crate) fn repo_path(relative: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(relative)
 }
 
 /// Path of a file in `tests/cli/data`.
-pub fn data_path(name: &str) -> PathBuf {
+pub(crate) fn data_path(name: &str) -> PathBuf {
     repo_path("tests/cli/data").join(name)
 }
 
 /// Unit vector (θ, φ in degrees), z = surface normal.
-pub fn direction(theta_deg: f64, phi_deg: f64) -> [f64; 3] {
+pub(crate) fn direction(theta_deg: f64, phi_deg: f64) -> [f64; 3] {
     let (st, ct) = theta_deg.to_radians().sin_cos();
     let (sp, cp) = phi_deg.to_radians().sin_cos();
     [st * cp, st * sp, ct]
 }
 
-pub use brtf_model::cone_solid_angle;
+pub(crate) use brtf_model::cone_solid_angle;
 
 /// `|a − b| ≤ abs` or `≤ rel·|b|`.
-pub fn close(a: f64, b: f64, rel: f64, abs: f64) -> bool {
+pub(crate) fn close(a: f64, b: f64, rel: f64, abs: f64) -> bool {
     let d = (a - b).abs();
     d <= abs || d <= rel * b.abs()
 }
@@ -186,7 +186,7 @@ pub fn close(a: f64, b: f64, rel: f64, abs: f64) -> bool {
 /// The Radiance `bin` folder holding every tool in `names` ($RADIANCE_BIN,
 /// else PATH, else pyradiance in the repo's `.venv`), or `None` after a
 /// loud warning that `test` did not run. Under CI a missing tool fails.
-pub fn radiance_tools_or_skip(test: &str, names: &[&str]) -> Option<PathBuf> {
+pub(crate) fn radiance_tools_or_skip(test: &str, names: &[&str]) -> Option<PathBuf> {
     let exe = |dir: &Path, name: &str| {
         let path = dir.join(format!("{name}{}", std::env::consts::EXE_SUFFIX));
         path.is_file().then_some(path)
@@ -236,7 +236,7 @@ pub fn radiance_tools_or_skip(test: &str, names: &[&str]) -> Option<PathBuf> {
 /// `name` from the Radiance `bin` folder, run in `dir`, with RAYPATH
 /// holding `.` and `bin/../lib` (pyradiance keeps `WINDOW6BSDFt.xml`
 /// there, which `wrapBSDF` needs).
-pub fn radiance_command(bin: &Path, name: &str, dir: &Path) -> std::process::Command {
+pub(crate) fn radiance_command(bin: &Path, name: &str, dir: &Path) -> std::process::Command {
     let mut cmd = std::process::Command::new(bin.join(name));
     cmd.current_dir(dir);
     let mut raypath = std::ffi::OsString::from(".");

@@ -327,8 +327,7 @@ fn xyz_data_are_fitted_and_exported_in_radiance_rgb() {
         .iter()
         .find(|s| s.theta_deg > 40.0 && s.theta_deg < 60.0)
         .unwrap();
-    let want =
-        brtf_model::rgb_to_xyz(bsdf.eval(m.incidence.direction(), sample.direction()));
+    let want = brtf_model::rgb_to_xyz(bsdf.eval(m.incidence.direction(), sample.direction()));
     for (got, want) in sample.values.iter().zip(want) {
         assert!(
             (got / want - 1.0).abs() < 1e-6,

@@ -136,7 +136,7 @@ mod options_serde {
         source_jitter: f64,
     }
 
-    pub fn serialize<S: Serializer>(o: &EvalOptions, s: S) -> Result<S::Ok, S::Error> {
+    pub(super) fn serialize<S: Serializer>(o: &EvalOptions, s: S) -> Result<S::Ok, S::Error> {
         Options {
             variant: o.variant.name().into(),
             fresnel_k: o.fresnel_k,
@@ -147,7 +147,7 @@ mod options_serde {
         .serialize(s)
     }
 
-    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<EvalOptions, D::Error> {
+    pub(super) fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<EvalOptions, D::Error> {
         let o = Options::deserialize(d)?;
         let variant: Variant = o.variant.parse().map_err(serde::de::Error::custom)?;
         Ok(EvalOptions {

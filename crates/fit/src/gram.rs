@@ -26,7 +26,7 @@ const MAX_LANES: usize = 8;
 impl RunColumns {
     /// Room for `rows` rows of `width` columns; the padding is zero, the
     /// rows are to be written.
-    pub fn reset(&mut self, rows: usize, width: usize) {
+    pub(crate) fn reset(&mut self, rows: usize, width: usize) {
         let stride = rows.div_ceil(MAX_LANES) * MAX_LANES;
         if self.stride != stride || self.data.len() != stride * width {
             self.data.clear();
@@ -41,7 +41,7 @@ impl RunColumns {
     }
 
     /// Column `c`'s rows.
-    pub fn column_mut(&mut self, c: usize) -> &mut [f64] {
+    pub(crate) fn column_mut(&mut self, c: usize) -> &mut [f64] {
         &mut self.data[c * self.stride..c * self.stride + self.rows]
     }
 }

@@ -55,12 +55,12 @@ mod tests;
 mod uncertainty;
 mod validate;
 
-pub use brtf_gonio::Gate;
-pub use config::{FitConfig, FitError, KnownReflectance, RobustLoss};
-pub use data::{FitSample, GateCount, IncidenceData, PatchPairs, Weighting};
 pub use adequacy::{
     Adequacy, ENERGY_TOLERANCE, PEAK_TOLERANCE_DEG, RESIDUAL_KIND_TOLERANCE, ResidualCheck,
 };
+pub use brtf_gonio::Gate;
+pub use config::{FitConfig, FitError, KnownReflectance, RobustLoss};
+pub use data::{FitSample, GateCount, IncidenceData, PatchPairs, Weighting};
 pub use fitter::{fit_global, fit_incidence};
 pub use params::{MAX_ROUGHNESS, MIN_ROUGHNESS, ParamMap, Slot, Target};
 pub use problem::ResidualKind;

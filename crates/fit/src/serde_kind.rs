@@ -3,11 +3,11 @@
 use brtf_model::MaterialKind;
 use serde::{Deserialize, Deserializer, Serializer};
 
-pub fn serialize<S: Serializer>(k: &MaterialKind, s: S) -> Result<S::Ok, S::Error> {
+pub(crate) fn serialize<S: Serializer>(k: &MaterialKind, s: S) -> Result<S::Ok, S::Error> {
     s.serialize_str(k.name())
 }
 
-pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<MaterialKind, D::Error> {
+pub(crate) fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<MaterialKind, D::Error> {
     String::deserialize(d)?
         .parse()
         .map_err(serde::de::Error::custom)

@@ -67,8 +67,8 @@ pub use read::{
 };
 pub use select::{DEFAULT_THETA_CAP_DEG, Gate, GateContext, PGII_HOLDER_BAND, Selection};
 pub use solid_angle::{
-    DISK_RADIUS, DirectionLayout, SolidAngleSource, SolidAngles, compute_solid_angles, detect_layout,
-    disk_voronoi_areas, project, reference_disk_voronoi_areas, solid_angles,
+    DISK_RADIUS, DirectionLayout, SolidAngleSource, SolidAngles, compute_solid_angles,
+    detect_layout, disk_voronoi_areas, project, reference_disk_voronoi_areas, solid_angles,
     voronoi_solid_angles,
 };
 pub use summary::{HemisphereSummary, Peak, Summary};

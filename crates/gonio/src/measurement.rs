@@ -534,10 +534,10 @@ impl Measurement {
 /// Serde helpers writing NaN ("not available") as JSON `null` and back.
 mod nan_as_null {
     /// For `f64` fields.
-    pub mod scalar {
+    pub(super) mod scalar {
         use serde::{Deserialize, Deserializer, Serializer};
 
-        pub fn serialize<S: Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
+        pub(crate) fn serialize<S: Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
             if v.is_nan() {
                 s.serialize_none()
             } else {
@@ -545,20 +545,20 @@ mod nan_as_null {
             }
         }
 
-        pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+        pub(crate) fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
             Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
         }
     }
 
     /// For `[f64; 3]` fields.
-    pub mod array3 {
+    pub(super) mod array3 {
         use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
-        pub fn serialize<S: Serializer>(v: &[f64; 3], s: S) -> Result<S::Ok, S::Error> {
+        pub(crate) fn serialize<S: Serializer>(v: &[f64; 3], s: S) -> Result<S::Ok, S::Error> {
             v.map(|x| (!x.is_nan()).then_some(x)).serialize(s)
         }
 
-        pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 3], D::Error> {
+        pub(crate) fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 3], D::Error> {
             Ok(<[Option<f64>; 3]>::deserialize(d)?.map(|x| x.unwrap_or(f64::NAN)))
         }
     }

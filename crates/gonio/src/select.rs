@@ -174,22 +174,6 @@ impl Gate {
         }
     }
 
-    /// A short label for legends: what the gate removed.
-    pub fn removed_label(&self) -> String {
-        match self {
-            Gate::Unavailable => "not available".into(),
-            Gate::Hemisphere {
-                keep: Hemisphere::Front,
-            } => "back hemisphere".into(),
-            Gate::Hemisphere {
-                keep: Hemisphere::Back,
-            } => "front hemisphere".into(),
-            Gate::ThetaCap { max_deg } => format!("θ_out > {max_deg}°"),
-            Gate::BeamMask { half_angle_deg } => format!("{half_angle_deg}° beam mask"),
-            Gate::MinValue { min } => format!("value < {min}"),
-            Gate::AzimuthBand { .. } => "holder band".into(),
-        }
-    }
 }
 
 impl std::fmt::Display for Gate {

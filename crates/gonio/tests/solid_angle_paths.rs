@@ -5,9 +5,9 @@
 
 use std::f64::consts::TAU;
 
-use brtf_gonio::{DirectionLayout, detect_layout, voronoi_solid_angles};
 use brtf_gonio::synth::{GroundTruth, Instrument, SynthSpec, synthesize};
 use brtf_gonio::{Channels, Hemisphere, Incidence, Sample, compute_solid_angles};
+use brtf_gonio::{DirectionLayout, detect_layout, voronoi_solid_angles};
 
 use crate::common::{golden, layer};
 

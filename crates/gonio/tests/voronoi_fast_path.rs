@@ -8,9 +8,7 @@
 
 use std::f64::consts::{PI, TAU};
 
-use brtf_gonio::{
-    DISK_RADIUS, disk_voronoi_areas, project, reference_disk_voronoi_areas,
-};
+use brtf_gonio::{DISK_RADIUS, disk_voronoi_areas, project, reference_disk_voronoi_areas};
 use brtf_gonio::{Hemisphere, Measurement, compute_solid_angles};
 
 use crate::common::{golden, layer};

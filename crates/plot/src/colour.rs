@@ -25,7 +25,7 @@ const RDBU: [(u8, u8, u8); 11] = [
 ];
 
 /// Diverging colour for `t` in [−1, 1] (clamped; NaN gives grey).
-pub fn diverging(t: f64) -> RGBColor {
+pub(crate) fn diverging(t: f64) -> RGBColor {
     if t.is_nan() {
         return MASKED;
     }
@@ -41,22 +41,22 @@ pub fn diverging(t: f64) -> RGBColor {
 }
 
 /// Samples that were not fitted (masked by a selection).
-pub const MASKED: RGBColor = RGBColor(190, 190, 190);
+pub(crate) const MASKED: RGBColor = RGBColor(190, 190, 190);
 
 /// Shading of masked ranges.
-pub const SHADE: RGBColor = RGBColor(228, 228, 228);
+pub(crate) const SHADE: RGBColor = RGBColor(228, 228, 228);
 
 /// Grid and guide lines.
-pub const GUIDE: RGBColor = RGBColor(120, 120, 120);
+pub(crate) const GUIDE: RGBColor = RGBColor(120, 120, 120);
 
 /// The data colour of single-series charts.
-pub const DATA: RGBColor = RGBColor(0, 0, 0);
+pub(crate) const DATA: RGBColor = RGBColor(0, 0, 0);
 
 /// The model colour of single-series charts.
-pub const MODEL: RGBColor = RGBColor(213, 94, 0);
+pub(crate) const MODEL: RGBColor = RGBColor(213, 94, 0);
 
 /// Marks things that need attention (parameters at a bound).
-pub const ALERT: RGBColor = RGBColor(204, 0, 0);
+pub(crate) const ALERT: RGBColor = RGBColor(204, 0, 0);
 
 const PALETTE: [RGBColor; 7] = [
     RGBColor(0, 114, 178),
@@ -69,7 +69,7 @@ const PALETTE: [RGBColor; 7] = [
 ];
 
 /// The colour of series `k` (cycling).
-pub fn series(k: usize) -> RGBColor {
+pub(crate) fn series(k: usize) -> RGBColor {
     PALETTE[k % PALETTE.len()]
 }
 

@@ -35,7 +35,7 @@ use rayon::prelude::*;
 use std::sync::OnceLock;
 
 /// Radius of the projected hemisphere.
-pub const RADIUS: f64 = std::f64::consts::SQRT_2;
+pub(crate) const RADIUS: f64 = std::f64::consts::SQRT_2;
 
 /// Projects unit direction `v` about the normal of `hemisphere`.
 pub fn project(v: DVec3, hemisphere: Hemisphere) -> (f64, f64) {
@@ -61,7 +61,11 @@ pub fn radius_of(theta_deg: f64) -> f64 {
 
 /// Points on the rim of the cone of half-angle `half_deg` about `axis`,
 /// projected, split where the cone leaves the hemisphere.
-pub fn cone_outline(axis: DVec3, half_deg: f64, hemisphere: Hemisphere) -> Vec<Vec<(f64, f64)>> {
+pub(crate) fn cone_outline(
+    axis: DVec3,
+    half_deg: f64,
+    hemisphere: Hemisphere,
+) -> Vec<Vec<(f64, f64)>> {
     let axis = axis.normalize();
     let helper = if axis.z.abs() < 0.9 {
         DVec3::Z
@@ -282,7 +286,7 @@ impl Seed {
 }
 
 /// Pixel value of [`Coverage::owner`] for pixels no sample reaches.
-pub const NONE: u32 = u32::MAX;
+pub(crate) const NONE: u32 = u32::MAX;
 
 /// Side in pixels of the coverage grid of one hemisphere.
 pub const COVERAGE_SIZE: u32 = 512;

@@ -24,13 +24,13 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 /// The font family every chart uses.
-pub const FONT: &str = "sans-serif";
+pub(crate) const FONT: &str = "sans-serif";
 
 /// A region of a chart's backend, in pixels: the whole chart or a part.
-pub type Area<DB> = DrawingArea<DB, Shift>;
+pub(crate) type Area<DB> = DrawingArea<DB, Shift>;
 
 /// Registers the embedded DejaVu Sans faces (once per process).
-pub fn register_fonts() {
+pub(crate) fn register_fonts() {
     static DONE: OnceLock<()> = OnceLock::new();
     DONE.get_or_init(|| {
         // Both faces are valid TrueType files shipped inside the binary.
@@ -70,7 +70,7 @@ pub struct Canvas {
 }
 
 /// Turns any displayable error into the message [`PlotError::Draw`] carries.
-pub trait OrMsg<T> {
+pub(crate) trait OrMsg<T> {
     /// The error's text.
     fn msg(self) -> Result<T, String>;
 }
@@ -254,7 +254,12 @@ thread_local! {
 }
 
 /// Encodes 8-bit pixels as PNG.
-pub fn encode_png(w: u32, h: u32, colour: png::ColorType, data: &[u8]) -> Result<Vec<u8>, String> {
+pub(crate) fn encode_png(
+    w: u32,
+    h: u32,
+    colour: png::ColorType,
+    data: &[u8],
+) -> Result<Vec<u8>, String> {
     let mut out = Vec::new();
     let mut encoder = png::Encoder::new(&mut out, w, h);
     encoder.set_color(colour);
@@ -272,7 +277,7 @@ pub fn encode_png(w: u32, h: u32, colour: png::ColorType, data: &[u8]) -> Result
 }
 
 /// Standard base64 with padding.
-pub fn base64(bytes: &[u8]) -> String {
+pub(crate) fn base64(bytes: &[u8]) -> String {
     const ALPHABET: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     let mut out = String::with_capacity(bytes.len().div_ceil(3) * 4);
     for chunk in bytes.chunks(3) {
@@ -295,7 +300,7 @@ pub fn base64(bytes: &[u8]) -> String {
 
 /// Writes `bytes` to `path` atomically (see [`brtf_io::write_atomic`]).
 /// Creates the folder when missing.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), PlotError> {
+pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), PlotError> {
     let folder = path.parent().filter(|p| !p.as_os_str().is_empty());
     folder
         .map_or(Ok(()), brtf_io::ensure_folder)
@@ -309,7 +314,10 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), PlotError> {
 
 /// Renders `chart` as `<dir>/<name>.svg` and `<dir>/<name>.png`: each
 /// path with its bytes, not yet written.
-pub fn render_files(chart: &impl Chart, dir: &Path) -> Result<Vec<(PathBuf, Vec<u8>)>, PlotError> {
+pub(crate) fn render_files(
+    chart: &impl Chart,
+    dir: &Path,
+) -> Result<Vec<(PathBuf, Vec<u8>)>, PlotError> {
     let (svg, png) = rayon::join(|| render_svg(chart), || render_png(chart));
     Ok(vec![
         (dir.join(format!("{}.svg", chart.name())), svg?.into_bytes()),

@@ -570,12 +570,6 @@ fn plot(
     })
 }
 
-/// Reads `<dir>/fit.json` and runs [`write_plots`].
-pub fn plot_dir(dir: &Path, options: &PlotOptions) -> Result<Written, PlotError> {
-    let result = read_fit(dir)?;
-    write_plots(dir, &result, options)
-}
-
 /// Removes `map-*` and `cut-*` plots that this run did not write.
 fn remove_stale(plots: &Path, written: &[PathBuf]) {
     let Ok(entries) = std::fs::read_dir(plots) else {

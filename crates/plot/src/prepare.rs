@@ -17,7 +17,7 @@
 //! of the three channels.
 
 use crate::disk::{self, Coverage};
-pub use brtf_fit::{DataUnit, Gate};
+pub(crate) use brtf_fit::{DataUnit, Gate};
 use brtf_fit::{FitReport, FitResult, InputFile, PreparedMeasurement, Recipe};
 use brtf_gonio::Hemisphere;
 use brtf_model::Bsdf;
@@ -105,7 +105,7 @@ pub struct Incidence {
 /// A cut of one incidence as [`crate::charts::cut::CutData`] shows it, with
 /// samples as indices into [`Incidence::samples`].
 #[derive(Debug, Clone)]
-pub struct CutCache {
+pub(crate) struct CutCache {
     /// Plane tolerance in degrees.
     pub tolerance: f64,
     /// `(x, sample index)` for the samples drawn.
@@ -392,7 +392,7 @@ pub fn load(
 /// Builds incidence `index` of `result` from the data the fit itself
 /// fitted (`prepared`, from [`brtf_fit::fit_set_with_data`]), without
 /// reading the file again. The same checks as [`load`] apply.
-pub fn from_prepared(
+pub(crate) fn from_prepared(
     result: &FitResult,
     index: usize,
     tag: String,
@@ -595,7 +595,7 @@ fn rebuild(
 
 /// File-name tags for every incidence: `t<θ>`, plus `-p<φ>` when a θ_in
 /// occurs more than once or φ_in is not 0, plus `-<k>` if still not unique.
-pub fn tags(reports: &[FitReport]) -> Vec<String> {
+pub(crate) fn tags(reports: &[FitReport]) -> Vec<String> {
     let mut tags: Vec<String> = reports
         .iter()
         .map(|r| {
@@ -616,7 +616,7 @@ pub fn tags(reports: &[FitReport]) -> Vec<String> {
 }
 
 /// A number for file names and labels: at most 4 decimals, no trailing zeros.
-pub fn num(x: f64) -> String {
+pub(crate) fn num(x: f64) -> String {
     let s = format!("{:.4}", x);
     let s = s.trim_end_matches('0').trim_end_matches('.');
     if s == "-0" { "0".into() } else { s.into() }

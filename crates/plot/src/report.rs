@@ -14,7 +14,7 @@ use std::path::Path;
 const MAX_EMBED: u64 = 256 * 1024;
 
 /// What the report shows of one incidence.
-pub struct IncidenceEntry<'a> {
+pub(crate) struct IncidenceEntry<'a> {
     /// The fit report.
     pub report: &'a FitReport,
     /// File-name tag (`t30`).
@@ -26,7 +26,7 @@ pub struct IncidenceEntry<'a> {
 }
 
 /// Everything the report needs.
-pub struct ReportInput<'a> {
+pub(crate) struct ReportInput<'a> {
     /// The fit folder (for the exported files).
     pub dir: &'a Path,
     /// The fit.
@@ -42,7 +42,7 @@ pub struct ReportInput<'a> {
 }
 
 /// HTML-escapes text.
-pub fn esc(s: &str) -> String {
+pub(crate) fn esc(s: &str) -> String {
     let mut out = String::with_capacity(s.len());
     for c in s.chars() {
         match c {
@@ -310,7 +310,7 @@ fn provenance_section(out: &mut String, dir: &Path, result: &FitResult) {
 }
 
 /// The page.
-pub fn html(input: &ReportInput) -> String {
+pub(crate) fn html(input: &ReportInput) -> String {
     let result = input.result;
     let mut out = String::new();
     let title = format!("{}: brtf fit report", result.name);

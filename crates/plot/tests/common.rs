@@ -6,31 +6,31 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 /// The repository root.
-pub fn repo() -> PathBuf {
+pub(crate) fn repo() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
 /// The exported material the report must embed (a stand-in written by
 /// the test; `brtf export` writes the real one).
-pub const RAD_TEXT: &str = "# test stand-in for the exported material\n\
+pub(crate) const RAD_TEXT: &str = "# test stand-in for the exported material\n\
                             void metal alu-ggx\n0\n0\n5 0.93 0.93 0.93 0.78 0.118\n";
 
 /// A fit folder with the data set's plots.
-pub struct Drawn {
+pub(crate) struct Drawn {
     pub dir: tempfile::TempDir,
     pub result: FitResult,
     pub written: Written,
 }
 
 impl Drawn {
-    pub fn path(&self, relative: &str) -> PathBuf {
+    pub(crate) fn path(&self, relative: &str) -> PathBuf {
         self.dir.path().join(relative)
     }
 }
 
 /// Copies `fits/alu-ggx/fit.json` into a fresh folder with a stand-in
 /// `.rad`, and draws every plot (once per test binary).
-pub fn drawn() -> &'static Drawn {
+pub(crate) fn drawn() -> &'static Drawn {
     static CELL: OnceLock<Drawn> = OnceLock::new();
     CELL.get_or_init(|| {
         let dir = tempfile::Builder::new()
@@ -58,10 +58,10 @@ pub fn drawn() -> &'static Drawn {
 }
 
 /// The file tags of the data set's five incidences.
-pub const TAGS: [&str; 5] = ["t0", "t15", "t30", "t45", "t60"];
+pub(crate) const TAGS: [&str; 5] = ["t0", "t15", "t30", "t45", "t60"];
 
 /// Width and height declared on an SVG's root element.
-pub fn svg_size(svg: &str) -> (u32, u32) {
+pub(crate) fn svg_size(svg: &str) -> (u32, u32) {
     let open = &svg[svg.find("<svg").expect("an <svg> element")..];
     let open = &open[..open.find('>').unwrap()];
     let attr = |name: &str| -> u32 {
@@ -78,7 +78,7 @@ pub fn svg_size(svg: &str) -> (u32, u32) {
 }
 
 /// Decodes a PNG completely; returns (width, height, RGB(A) bytes, channels).
-pub fn decode_png(path: &Path) -> (u32, u32, Vec<u8>, usize) {
+pub(crate) fn decode_png(path: &Path) -> (u32, u32, Vec<u8>, usize) {
     let file = std::fs::File::open(path).unwrap();
     let mut decoder = png::Decoder::new(std::io::BufReader::new(file))
         .read_info()
@@ -91,7 +91,7 @@ pub fn decode_png(path: &Path) -> (u32, u32, Vec<u8>, usize) {
 }
 
 /// Every `href="…"` and `src="…"` value in `html`.
-pub fn links(html: &str) -> Vec<String> {
+pub(crate) fn links(html: &str) -> Vec<String> {
     let mut out = Vec::new();
     for key in ["href=\"", "src=\""] {
         let mut rest = html;
@@ -106,7 +106,7 @@ pub fn links(html: &str) -> Vec<String> {
 }
 
 /// Undoes the report's %XX escapes.
-pub fn percent_decode(s: &str) -> String {
+pub(crate) fn percent_decode(s: &str) -> String {
     let bytes = s.as_bytes();
     let mut out = Vec::new();
     let mut i = 0;

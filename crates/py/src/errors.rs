@@ -5,7 +5,7 @@ use pyo3::prelude::*;
 
 /// Which Python class an error becomes.
 #[derive(Clone, Copy)]
-pub enum Class {
+pub(crate) enum Class {
     /// A file that is not valid (measurement, `.rad`, `fit.json`).
     Format,
     /// A file that does not exist.
@@ -34,7 +34,12 @@ impl Class {
 }
 
 /// A `brtf.<Class>` exception with `message`, `file` and `line`.
-pub fn error(class: Class, message: String, file: Option<String>, line: Option<usize>) -> PyErr {
+pub(crate) fn error(
+    class: Class,
+    message: String,
+    file: Option<String>,
+    line: Option<usize>,
+) -> PyErr {
     Python::attach(|py| {
         let made = py
             .import("brtf._errors")
@@ -48,12 +53,12 @@ pub fn error(class: Class, message: String, file: Option<String>, line: Option<u
 }
 
 /// A `brtf.ModelError` (bad argument) with no file.
-pub fn model(message: impl Into<String>) -> PyErr {
+pub(crate) fn model(message: impl Into<String>) -> PyErr {
     error(Class::Model, message.into(), None, None)
 }
 
 /// The class for an I/O error: missing file or other.
-pub fn io_class(e: &std::io::Error) -> Class {
+pub(crate) fn io_class(e: &std::io::Error) -> Class {
     if e.kind() == std::io::ErrorKind::NotFound {
         Class::MissingFile
     } else {
@@ -62,7 +67,7 @@ pub fn io_class(e: &std::io::Error) -> Class {
 }
 
 /// A measurement file that could not be read.
-pub fn read(e: brtf_gonio::ReadError) -> PyErr {
+pub(crate) fn read(e: brtf_gonio::ReadError) -> PyErr {
     let file = Some(e.path().display().to_string());
     match &e {
         brtf_gonio::ReadError::Io { source, .. } => {
@@ -77,13 +82,13 @@ pub fn read(e: brtf_gonio::ReadError) -> PyErr {
 }
 
 /// A Radiance text that could not be read.
-pub fn rad(e: brtf_radiance::RadError) -> PyErr {
+pub(crate) fn rad(e: brtf_radiance::RadError) -> PyErr {
     let (file, line) = (Some(e.path.clone()), Some(e.line));
     error(Class::Format, e.to_string(), file, line)
 }
 
 /// A fit set that could not be made.
-pub fn fit_set(e: brtf_fit::FitSetError) -> PyErr {
+pub(crate) fn fit_set(e: brtf_fit::FitSetError) -> PyErr {
     use brtf_fit::FitSetError;
     match e {
         FitSetError::Io { path, source } => {
@@ -101,7 +106,7 @@ pub fn fit_set(e: brtf_fit::FitSetError) -> PyErr {
 }
 
 /// A `fit.json` that could not be read.
-pub fn read_fit(e: brtf_fit::ReadFitError, path: &std::path::Path) -> PyErr {
+pub(crate) fn read_fit(e: brtf_fit::ReadFitError, path: &std::path::Path) -> PyErr {
     let file = Some(path.display().to_string());
     let message = e.to_string();
     match &e {
@@ -114,12 +119,12 @@ pub fn read_fit(e: brtf_fit::ReadFitError, path: &std::path::Path) -> PyErr {
 }
 
 /// Writing outputs failed.
-pub fn export(message: String) -> PyErr {
+pub(crate) fn export(message: String) -> PyErr {
     error(Class::Export, message, None, None)
 }
 
 /// A fit, export or folder step that failed.
-pub fn workflow(e: brtf_workflow::WorkflowError) -> PyErr {
+pub(crate) fn workflow(e: brtf_workflow::WorkflowError) -> PyErr {
     use brtf_workflow::WorkflowError;
     match e {
         WorkflowError::Usage(message) => error(Class::Fit, message, None, None),

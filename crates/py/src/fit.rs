@@ -67,7 +67,7 @@ fn input_paths(inputs: &Bound<'_, PyAny>) -> PyResult<Vec<PathBuf>> {
 /// Runs the fit: reads every file and fits it, on `jobs` threads (all
 /// cores by default) with the GIL released. A Klems BSDF XML file is fitted
 /// one side at a time (`settings.sides` front or back).
-pub fn run_fit(
+pub(crate) fn run_fit(
     py: Python<'_>,
     inputs: &Bound<'_, PyAny>,
     settings: FitSettings,

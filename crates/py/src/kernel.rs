@@ -7,7 +7,7 @@ use brtf_model::{Bsdf, direction};
 /// (`theta_in[i]`, `phi_in[i]`) seen from (`theta_out[i]`, `phi_out[i]`),
 /// all in degrees, as `brtf eval` computes it. All slices have the same
 /// length; `out` is three times as long.
-pub fn eval_degrees(
+pub(crate) fn eval_degrees(
     bsdf: &Bsdf,
     theta_in: &[f64],
     phi_in: &[f64],
@@ -26,7 +26,7 @@ pub fn eval_degrees(
 
 /// The same for one incidence and many outgoing directions: the light
 /// direction is computed once (the common case, and `brtf eval`'s).
-pub fn eval_degrees_one_incidence(
+pub(crate) fn eval_degrees_one_incidence(
     bsdf: &Bsdf,
     theta_in: f64,
     phi_in: f64,

@@ -23,7 +23,7 @@ pub struct Material {
 }
 
 /// `fresnel_k`: `"classic"`, `"pyradiance"` or a number.
-pub fn parse_fresnel_k(value: &Bound<'_, PyAny>) -> PyResult<f64> {
+pub(crate) fn parse_fresnel_k(value: &Bound<'_, PyAny>) -> PyResult<f64> {
     if let Ok(text) = value.extract::<String>() {
         return brtf_model::parse_fresnel_k(&text)
             .map_err(|e| errors::model(format!("fresnel_k={text:?}: {e}")));
@@ -35,14 +35,14 @@ pub fn parse_fresnel_k(value: &Bound<'_, PyAny>) -> PyResult<f64> {
 
 /// The keyword argument `what=value` read as one of a library enum's words
 /// (a `brtf.ModelError` listing them otherwise).
-pub fn word<T: std::str::FromStr<Err = WordError>>(what: &str, value: &str) -> PyResult<T> {
+pub(crate) fn word<T: std::str::FromStr<Err = WordError>>(what: &str, value: &str) -> PyResult<T> {
     value
         .parse::<T>()
         .map_err(|e| errors::model(format!("{what}={value:?}: {e}")))
 }
 
 /// The evaluation options, checked.
-pub fn eval_options(
+pub(crate) fn eval_options(
     variant: &str,
     fresnel_k: &Bound<'_, PyAny>,
     source_omega: f64,

@@ -199,7 +199,7 @@ fn header_pairs(lines: &[String]) -> Vec<(String, String)> {
 
 /// Reads one measurement file (`.mpc` or pab-opto Mountain).
 #[pyfunction]
-pub fn read(py: Python<'_>, path: PathBuf) -> PyResult<Measurement> {
+pub(crate) fn read(py: Python<'_>, path: PathBuf) -> PyResult<Measurement> {
     let scan = py
         .detach(|| brtf_gonio::read_path(&path))
         .map_err(errors::read)?;
@@ -210,7 +210,7 @@ pub fn read(py: Python<'_>, path: PathBuf) -> PyResult<Measurement> {
 /// Reads a Klems BSDF XML file: one Measurement per incident patch and side.
 #[pyfunction]
 #[pyo3(signature = (path, side = "both"))]
-pub fn read_klems(py: Python<'_>, path: PathBuf, side: &str) -> PyResult<Vec<Measurement>> {
+pub(crate) fn read_klems(py: Python<'_>, path: PathBuf, side: &str) -> PyResult<Vec<Measurement>> {
     let keep = match side {
         "both" => None,
         "front" => Some(90.0),

@@ -16,12 +16,12 @@
 //! one process. Rays = camera rays + shadow rays, counted by brtf-trace
 //! (rtrace traces the same ones).
 
+use brtf_model::Rng;
 use brtf_model::{EvalOptions, Material, MaterialKind};
 use brtf_trace::GonioSetup;
 use brtf_trace::RayCounts;
-use brtf_trace::{ReflectionLobe, TransmissionLobe};
-use brtf_model::Rng;
 use brtf_trace::{Camera, ImageOptions, Scene, Settings, Shader, Shape, Source, VirtualGonio};
+use brtf_trace::{ReflectionLobe, TransmissionLobe};
 use criterion::{BenchmarkId, Criterion, Throughput};
 use glam::DVec3;
 use std::hint::black_box;

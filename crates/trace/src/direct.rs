@@ -23,9 +23,9 @@ use glam::DVec3;
 use crate::camera::Camera;
 use crate::frame::Frame;
 use crate::integrator::{ImageOptions, RayCounts, Tracer};
-use brtf_model::Rng;
 use crate::sampling::sin_cos_turns;
 use crate::scene::{RAY_EPSILON, Scene, Shape, Source};
+use brtf_model::Rng;
 
 /// A `Vec<f64>` per coordinate.
 #[derive(Debug, Default)]

@@ -23,13 +23,13 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::integrator::{RayCounts, Settings, Tracer};
-use brtf_model::Rng;
 use crate::sampling::{cone_half_angle, uniform_cone};
 use crate::scene::{Ray, Scene, Shape, Source};
 use crate::shader::Shader;
+use brtf_model::Rng;
 
 /// The smallest source solid angle used (a "point" source), sr.
-pub const MIN_SOURCE_OMEGA: f64 = 1e-10;
+pub(crate) const MIN_SOURCE_OMEGA: f64 = 1e-10;
 
 /// A gonio-photometer's geometry and the sampling effort.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -146,7 +146,7 @@ pub fn aperture_solid_angle(
 }
 
 /// The most directions [`grid`] returns.
-pub const MAX_GRID_DIRECTIONS: usize = 10_000_000;
+pub(crate) const MAX_GRID_DIRECTIONS: usize = 10_000_000;
 
 /// A direction grid (θ_out, φ_out in degrees): θ_out from 0 to 85° (and
 /// 180 − θ_out, the back hemisphere, with `back`) in `theta_step` steps,
@@ -311,41 +311,13 @@ impl VirtualGonio {
         (values, total)
     }
 
-    /// Renders the geometry of `like` (its incidence is ignored: the
-    /// setup's is used) and returns a BSDF measurement with the same
-    /// samples, `channels` values each (1: luminance, 3: the material's
-    /// three channels).
-    pub fn render_like(&self, like: &Measurement, channels: Channels) -> (Measurement, RayCounts) {
-        let dirs: Vec<DVec3> = like.samples.iter().map(|s| s.direction()).collect();
-        let (values, counts) = self.render(&dirs);
-        let samples = like
-            .samples
-            .iter()
-            .zip(&values)
-            .map(|(s, v)| Sample {
-                theta_deg: s.theta_deg,
-                phi_deg: s.phi_deg,
-                values: channel_values(v.bsdf, channels),
-                solid_angle_sr: s.solid_angle_sr,
-            })
-            .collect();
-        let mut m = Measurement::new(
-            like.format,
-            Incidence::new(self.setup.theta_in, self.setup.phi_in),
-            Quantity::Bsdf,
-            channels,
-            samples,
-        );
-        m.sample_name = like.sample_name.clone();
-        (m, counts)
-    }
 }
 
 /// `n` points in [0,1)², one in each of `n` distinct cells of the
 /// smallest m × m grid with m² ≥ n (cells chosen at random when m² > n),
 /// in random order. Each point is uniform over [0,1)², so estimates stay
 /// unbiased, and the set covers the square evenly.
-pub fn stratified_cells(n: usize, rng: &mut Rng) -> Vec<[f64; 2]> {
+pub(crate) fn stratified_cells(n: usize, rng: &mut Rng) -> Vec<[f64; 2]> {
     let m = (n as f64).sqrt().ceil() as usize;
     let mut cells: Vec<usize> = (0..m * m).collect();
     // Fisher–Yates shuffle.
@@ -368,7 +340,7 @@ pub fn stratified_cells(n: usize, rng: &mut Rng) -> Vec<[f64; 2]> {
 
 /// Measurement slot values of a rendered RGB value: its luminance, or its
 /// CIE XYZ (what the file's colorimetry header says the values are).
-pub fn channel_values(c: Rgb, channels: Channels) -> [f64; 3] {
+pub(crate) fn channel_values(c: Rgb, channels: Channels) -> [f64; 3] {
     match channels {
         Channels::Y => [brtf_model::luminance(c), 0.0, 0.0],
         Channels::Xyz => brtf_model::rgb_to_xyz(c),
@@ -401,7 +373,7 @@ pub fn measurement_from(
 /// `∫_cone max(0, ±cos θ) dω` over the cone of half-angle `a` around
 /// `axis`, on the side of the surface the axis is on: `π sin²a |cos θ₀|`
 /// when the cone does not cross the horizon, else by quadrature.
-pub fn cone_cosine_integral(axis: DVec3, a: f64) -> f64 {
+pub(crate) fn cone_cosine_integral(axis: DVec3, a: f64) -> f64 {
     let c0 = axis.z.abs();
     // The cone stays on one side when the axis is at least `a` from the horizon.
     if c0 >= a.sin() {
@@ -418,7 +390,7 @@ pub fn cone_cosine_integral(axis: DVec3, a: f64) -> f64 {
 /// cone of half-angle `a` around `axis` (Gauss–Legendre in the polar
 /// angle, the trapezoid rule in azimuth); the weights sum to the cone's
 /// solid angle.
-pub fn quadrature_cone(
+pub(crate) fn quadrature_cone(
     axis: DVec3,
     a: f64,
     radial: usize,
@@ -484,4 +456,3 @@ pub fn cone_average(
     });
     std::array::from_fn(|k| num[k] / (den * wsum_v))
 }
-

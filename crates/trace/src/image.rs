@@ -14,9 +14,8 @@ use crate::camera::Camera;
 use crate::direct::DirectRows;
 use crate::hdr::Picture;
 use crate::integrator::{ImageOptions, RayCounts, Tracer};
-use brtf_model::Rng;
 use crate::scene::Scene;
-
+use brtf_model::Rng;
 
 /// A rendered picture and what it cost.
 #[derive(Debug, Clone)]
@@ -84,7 +83,7 @@ pub fn render(scene: &Scene, camera: &Camera, options: &ImageOptions) -> Rendere
 }
 
 /// Luminance-like brightness of an RGB value (Radiance's `bright()`).
-pub fn brightness(c: [f32; 3]) -> f64 {
+pub(crate) fn brightness(c: [f32; 3]) -> f64 {
     brtf_model::luminance(c.map(f64::from))
 }
 
@@ -115,7 +114,7 @@ fn srgb(x: f64) -> f64 {
 }
 
 /// Tone-maps to 8-bit sRGB: multiply by `exposure`, clip, sRGB gamma.
-pub fn tone_map(picture: &Picture, exposure: f64) -> Vec<u8> {
+pub(crate) fn tone_map(picture: &Picture, exposure: f64) -> Vec<u8> {
     let mut out = Vec::with_capacity(picture.pixels.len() * 3);
     for p in &picture.pixels {
         for &c in p {

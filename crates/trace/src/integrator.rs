@@ -20,9 +20,9 @@
 use brtf_model::Rgb;
 use glam::DVec3;
 
-use brtf_model::Rng;
 use crate::sampling::cosine_hemisphere;
 use crate::scene::{Hit, PreparedSource, RAY_EPSILON, Ray, Scene};
+use brtf_model::Rng;
 
 use crate::sampling::{ReflectionLobe, TransmissionLobe};
 

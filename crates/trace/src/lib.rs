@@ -53,8 +53,8 @@ pub use camera::Camera;
 pub use check::{CheckOptions, CheckReport, check_fit};
 pub use frame::Frame;
 pub use gonio::{
-    Aperture, GonioError, GonioSetup, GonioValue, VirtualGonio, aperture_solid_angle,
-    cone_average, grid, measurement_from,
+    Aperture, GonioError, GonioSetup, GonioValue, VirtualGonio, aperture_solid_angle, cone_average,
+    grid, measurement_from,
 };
 pub use image::{Rendered, auto_exposure, render, write_png};
 pub use integrator::{ImageOptions, RayCounts, Settings, Tracer};

@@ -101,12 +101,12 @@ pub fn one_minus_cos(a: f64) -> f64 {
 /// Solid angle of the spherical cap of half-angle `a` (radians): `2π(1 − cos a)`
 /// (not [`brtf_model::cone_solid_angle`], which takes a full apex angle in degrees).
 #[inline]
-pub fn cap_solid_angle(half_angle: f64) -> f64 {
+pub(crate) fn cap_solid_angle(half_angle: f64) -> f64 {
     2.0 * PI * one_minus_cos(half_angle)
 }
 
 /// Half-angle (radians) of the cone of solid angle `omega` (sr).
-pub fn cone_half_angle(omega: f64) -> f64 {
+pub(crate) fn cone_half_angle(omega: f64) -> f64 {
     // ω = 4π sin²(a/2).
     2.0 * (omega / (4.0 * PI)).clamp(0.0, 1.0).sqrt().asin()
 }

@@ -86,10 +86,6 @@ impl Shape {
         }
     }
 
-    /// Radiance calls a polygon or ring "flat"; a sphere is not.
-    pub fn is_flat(&self) -> bool {
-        matches!(self, Shape::Disk { .. })
-    }
 }
 
 #[inline]
@@ -307,7 +303,7 @@ pub struct Scene {
 }
 
 /// Rays start this far off a surface.
-pub const RAY_EPSILON: f64 = 1e-7;
+pub(crate) const RAY_EPSILON: f64 = 1e-7;
 
 impl Scene {
     /// An empty scene with a black background.

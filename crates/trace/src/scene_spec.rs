@@ -28,13 +28,13 @@ pub const FLOOR_RADIUS: f64 = 6.0;
 /// Centre of the sphere.
 pub const BALL_CENTER: DVec3 = DVec3::new(0.0, 0.0, 1.0);
 /// Radius of the sphere.
-pub const BALL_RADIUS: f64 = 1.0;
+pub(crate) const BALL_RADIUS: f64 = 1.0;
 /// The name the Radiance text's floor and sphere use as their modifier:
 /// the material primitive given to [`SceneSpec::radiance_text`] must
 /// carry it.
 pub const MATERIAL_NAME: &str = "sample";
 /// The largest picture, in pixels.
-pub const MAX_PIXELS: usize = 64_000_000;
+pub(crate) const MAX_PIXELS: usize = 64_000_000;
 
 /// What the picture shows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -33,10 +33,10 @@ use crate::frame::Frame;
 use crate::sampling::{ReflectionLobe, TransmissionLobe};
 
 /// Grid step (degrees) of a θ_in-table shader.
-pub const TABLE_STEP_DEG: f64 = 0.25;
+pub(crate) const TABLE_STEP_DEG: f64 = 0.25;
 
 /// Grid steps (degrees) in θ_in and φ_in of a table that follows φ_in.
-pub const AZIMUTH_GRID_STEP_DEG: (f64, f64) = (1.0, 2.5);
+pub(crate) const AZIMUTH_GRID_STEP_DEG: (f64, f64) = (1.0, 2.5);
 
 /// rtrace clamps the view cosine (`pdot >= .001`).
 const MIN_VIEW_COSINE: f64 = 0.001;

@@ -6,17 +6,17 @@ use brtf_model::{EvalOptions, Material, MaterialKind};
 use glam::DVec3;
 
 /// A material from its kind and arguments (orientation +x for `*2`).
-pub fn mat(kind: MaterialKind, args: &[f64]) -> Material {
+pub(crate) fn mat(kind: MaterialKind, args: &[f64]) -> Material {
     Material::new(kind, args, Some(DVec3::new(1.0, 0.3, 0.0))).expect("valid material")
 }
 
 /// Default options (radiance variant, ω = 0).
-pub fn opts() -> EvalOptions {
+pub(crate) fn opts() -> EvalOptions {
     EvalOptions::default()
 }
 
 /// A set of materials covering every type.
-pub fn zoo() -> Vec<(&'static str, Material)> {
+pub(crate) fn zoo() -> Vec<(&'static str, Material)> {
     use MaterialKind::*;
     vec![
         ("plastic", mat(Plastic, &[0.6, 0.5, 0.4, 0.05, 0.1])),
@@ -34,7 +34,7 @@ pub fn zoo() -> Vec<(&'static str, Material)> {
 
 /// Regularised upper incomplete gamma Q(a, x) (Numerical Recipes: series
 /// for x < a + 1, continued fraction otherwise).
-pub fn gamma_q(a: f64, x: f64) -> f64 {
+pub(crate) fn gamma_q(a: f64, x: f64) -> f64 {
     if x <= 0.0 {
         return 1.0;
     }
@@ -81,7 +81,7 @@ pub fn gamma_q(a: f64, x: f64) -> f64 {
 }
 
 /// ln Γ(x), Lanczos approximation (g = 7, n = 9).
-pub fn ln_gamma(x: f64) -> f64 {
+pub(crate) fn ln_gamma(x: f64) -> f64 {
     const C: [f64; 9] = [
         0.999_999_999_999_809_9,
         676.520_368_121_885_1,
@@ -107,7 +107,7 @@ pub fn ln_gamma(x: f64) -> f64 {
 }
 
 /// p-value of a chi² statistic with `dof` degrees of freedom.
-pub fn chi2_p_value(chi2: f64, dof: usize) -> f64 {
+pub(crate) fn chi2_p_value(chi2: f64, dof: usize) -> f64 {
     gamma_q(0.5 * dof as f64, 0.5 * chi2)
 }
 

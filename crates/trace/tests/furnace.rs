@@ -6,8 +6,8 @@
 //! parts get the one-bounce rays, roughness-0 surfaces trace their deltas.
 
 use crate::common::{mat, zoo};
-use brtf_model::{Bsdf, EvalOptions, MaterialKind, albedo};
 use brtf_model::Rng;
+use brtf_model::{Bsdf, EvalOptions, MaterialKind, albedo};
 use brtf_trace::{Ray, RayCounts, Scene, Settings, Shader, Shape, Tracer};
 use glam::DVec3;
 

@@ -4,8 +4,8 @@
 use crate::common::mat;
 use brtf_model::{EvalOptions, MaterialKind};
 use brtf_trace::hdr;
-use brtf_trace::{auto_exposure, write_png};
 use brtf_trace::{Camera, ImageOptions, Scene, Settings, Shader, Shape, Source, render};
+use brtf_trace::{auto_exposure, write_png};
 use glam::DVec3;
 
 fn scene() -> Scene {
@@ -176,9 +176,9 @@ fn batched_direct_rows_equal_the_per_ray_tracer_one_sample() {
 /// material if `glass`, else of the first) and a sphere light, and
 /// compares every pixel with [`Tracer::radiance`].
 fn direct_rows_equal_the_per_ray_tracer(options: &ImageOptions, glass: bool) {
-    use brtf_trace::RayCounts;
     use brtf_model::Rng;
-use brtf_trace::{Tracer};
+    use brtf_trace::RayCounts;
+    use brtf_trace::Tracer;
     let mut scene = scene();
     // A second, transmitting material lit from behind, and a sphere light.
     let id = if glass {

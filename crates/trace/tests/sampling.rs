@@ -10,8 +10,8 @@
 //! 0.01/(number of tests).
 
 use crate::common::chi2_p_value;
-use brtf_model::gauss_legendre_rule as gauss_legendre;
 use brtf_model::Rng;
+use brtf_model::gauss_legendre_rule as gauss_legendre;
 use brtf_trace::Frame;
 use brtf_trace::{
     ReflectionLobe, TransmissionLobe, cosine_hemisphere, cosine_hemisphere_pdf, uniform_cone,

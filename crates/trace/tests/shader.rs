@@ -3,9 +3,9 @@
 
 use crate::common::{mat, zoo};
 use brtf_fit::{Interpolation, ParamTable};
-use brtf_model::{Bsdf, EvalOptions, MaterialKind, Variant};
 use brtf_model::Rng;
-use brtf_trace::{Shader};
+use brtf_model::{Bsdf, EvalOptions, MaterialKind, Variant};
+use brtf_trace::Shader;
 use glam::DVec3;
 
 fn random_dir(rng: &mut Rng) -> DVec3 {

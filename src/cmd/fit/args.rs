@@ -12,7 +12,7 @@ use clap::Args;
 use std::path::PathBuf;
 
 #[derive(Args, Debug)]
-pub struct FitArgs {
+pub(crate) struct FitArgs {
     /// Measurement files, one incidence each (.mpc or pab-opto Mountain); or
     /// Klems BSDF XML files (each incident patch of a side an incidence,
     /// docs/klems.md); or sample folders, one sample each (its .mpc and
@@ -131,7 +131,7 @@ pub struct FitArgs {
 
 impl FitArgs {
     /// The fit settings these arguments give.
-    pub fn settings(&self) -> anyhow::Result<FitSettings> {
+    pub(crate) fn settings(&self) -> anyhow::Result<FitSettings> {
         let Some(model) = self.model else {
             anyhow::bail!("--model is needed to fit measurement files");
         };
@@ -171,7 +171,7 @@ impl FitArgs {
     }
 
     /// The optional outputs asked for.
-    pub fn outputs(&self) -> Outputs {
+    pub(crate) fn outputs(&self) -> Outputs {
         Outputs {
             export: !self.no_export,
             plots: !self.no_plots,

@@ -7,7 +7,7 @@ mod args;
 use crate::cmd::output::print;
 use crate::cmd::shared::with_jobs;
 use anyhow::{Result, bail};
-pub use args::FitArgs;
+pub(crate) use args::FitArgs;
 use brtf_fit::Progress;
 use brtf_workflow::{FitInputs, FitJob, FolderRequest, FolderRun};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -55,13 +55,13 @@ impl Progress for Bar {
 }
 
 /// The command line, for the provenance (lossy where not UTF-8).
-pub fn command_line() -> Vec<String> {
+pub(crate) fn command_line() -> Vec<String> {
     std::env::args_os()
         .map(|a| a.to_string_lossy().into_owned())
         .collect()
 }
 
-pub fn run(args: FitArgs) -> Result<()> {
+pub(crate) fn run(args: FitArgs) -> Result<()> {
     if let Some(values) = &args.en14501 {
         let text = brtf_workflow::en14501_material(values, args.name.as_deref(), &command_line())?;
         return print(&text);

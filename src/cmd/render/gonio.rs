@@ -12,7 +12,7 @@ use glam::DVec3;
 use std::path::PathBuf;
 
 #[derive(Args, Debug)]
-pub struct GonioArgs {
+pub(crate) struct GonioArgs {
     #[command(flatten)]
     pub sample: SampleMaterial,
     /// Reproduce this measurement's geometry: its incidence and every sample direction.
@@ -68,7 +68,7 @@ pub struct GonioArgs {
     pub force: bool,
 }
 
-pub fn run(args: GonioArgs) -> Result<()> {
+pub(crate) fn run(args: GonioArgs) -> Result<()> {
     let loaded = args.sample.load()?;
     let like: Option<Measurement> = match &args.like {
         Some(p) => {

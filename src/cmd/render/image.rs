@@ -4,9 +4,9 @@ use super::SampleMaterial;
 use crate::cmd::output::write_atomic;
 use crate::cmd::shared::{with_jobs, words};
 use anyhow::Result;
-use brtf_trace::{auto_exposure, write_png};
 use brtf_trace::MATERIAL_NAME;
 use brtf_trace::{LightKind, LightSpec, SceneKind, SceneSpec, Settings, ViewSpec, hdr};
+use brtf_trace::{auto_exposure, write_png};
 use clap::Args;
 use std::path::PathBuf;
 
@@ -14,7 +14,7 @@ use std::path::PathBuf;
 const D: SceneSpec = SceneSpec::DEFAULT;
 
 #[derive(Args, Debug)]
-pub struct ImageArgs {
+pub(crate) struct ImageArgs {
     #[command(flatten)]
     pub sample: SampleMaterial,
     /// Output prefix: writes PREFIX.hdr (Radiance RGBE) and PREFIX.png
@@ -149,7 +149,7 @@ impl ImageArgs {
     }
 }
 
-pub fn run(args: ImageArgs) -> Result<()> {
+pub(crate) fn run(args: ImageArgs) -> Result<()> {
     let spec = args.spec();
     spec.validate()?;
     let samples = f64::from(args.samples);

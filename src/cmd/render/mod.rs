@@ -13,8 +13,8 @@
 //! The scenes, grids and checks live in brtf-trace; this module maps the
 //! options onto them, reports progress and writes the files.
 
-pub mod gonio;
-pub mod image;
+pub(crate) mod gonio;
+pub(crate) mod image;
 
 use super::material::{FormulaArgs, MaterialArgs};
 use super::shared::words;
@@ -28,20 +28,20 @@ use image::ImageArgs;
 use std::path::PathBuf;
 
 #[derive(Args, Debug)]
-pub struct RenderArgs {
+pub(crate) struct RenderArgs {
     #[command(subcommand)]
     pub what: RenderWhat,
 }
 
 #[derive(Subcommand, Debug)]
-pub enum RenderWhat {
+pub(crate) enum RenderWhat {
     /// Virtual gonio-photometer: the rendered BSDF at a measurement's directions.
     Gonio(GonioArgs),
     /// A picture of the material on a sphere and a plane (HDR + PNG).
     Image(ImageArgs),
 }
 
-pub fn run(args: RenderArgs) -> Result<()> {
+pub(crate) fn run(args: RenderArgs) -> Result<()> {
     match args.what {
         RenderWhat::Gonio(a) => gonio::run(a),
         RenderWhat::Image(a) => image::run(a),
@@ -50,7 +50,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
 
 /// Where the material comes from.
 #[derive(Args, Debug, Clone)]
-pub struct SampleMaterial {
+pub(crate) struct SampleMaterial {
     /// Radiance file holding the material primitive(s).
     #[arg(
         long,
@@ -78,7 +78,7 @@ pub struct SampleMaterial {
 }
 
 /// A loaded material: the shader and a one-set material for exports.
-pub struct Loaded {
+pub(crate) struct Loaded {
     pub shader: Shader,
     /// The static material (the fit's all-incidence set, or the file's).
     pub material: Material,
@@ -88,7 +88,7 @@ pub struct Loaded {
 }
 
 impl SampleMaterial {
-    pub fn load(&self) -> Result<Loaded> {
+    pub(crate) fn load(&self) -> Result<Loaded> {
         if let Some(dir) = &self.fit {
             let fit = brtf_workflow::read_fit(dir)?;
             let mut options = fit.options();

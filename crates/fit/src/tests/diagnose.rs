@@ -4,10 +4,10 @@
 //! residual-kind comparison, and the warnings at each tolerance.
 
 use super::{measurement, report, ring_directions};
-use crate::config::FitConfig;
 use crate::adequacy::{
     Adequacy, ENERGY_TOLERANCE, PEAK_TOLERANCE_DEG, RESIDUAL_KIND_TOLERANCE, ResidualCheck,
 };
+use crate::config::FitConfig;
 use crate::diagnose::{compare, diagnose, other_residual, warnings};
 use crate::problem::ResidualKind;
 use crate::recipe::{ColourConversion, PreparedMeasurement, Recipe, ScaleRule, WeightRule};

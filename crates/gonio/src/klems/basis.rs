@@ -141,7 +141,7 @@ const BUILT_IN: [(&str, &[f64], &[usize]); 3] = [
 
 /// More patches than any real basis has; refusing larger ones keeps a
 /// hostile file from asking for a huge matrix.
-pub const MAX_PATCHES: usize = 4096;
+pub(super) const MAX_PATCHES: usize = 4096;
 
 /// The three built-in Klems bases by size.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]

@@ -31,7 +31,7 @@ use super::{KlemsBasis, Side};
 pub const DEFAULT_SAMPLES: usize = 4096;
 
 /// The largest [`grazing_boost`].
-pub const HORIZON_BOOST: usize = 16;
+pub(super) const HORIZON_BOOST: usize = 16;
 
 /// How many times the samples a patch gets: 16 for patches that reach
 /// the horizon, 4 for those that reach 75°, else 1. An entry uses the
@@ -40,7 +40,7 @@ pub const HORIZON_BOOST: usize = 16;
 /// tails that converge slowly. In the Full basis 144 of the 21 025
 /// entries get 16×, 640 more 4×: the whole matrix costs about 1.3× the
 /// base count.
-pub fn grazing_boost(patch: &super::KlemsPatch) -> usize {
+pub(super) fn grazing_boost(patch: &super::KlemsPatch) -> usize {
     let upper = patch.theta_bounds_deg.1;
     if upper >= 90.0 - 1e-9 {
         HORIZON_BOOST
@@ -52,7 +52,7 @@ pub fn grazing_boost(patch: &super::KlemsPatch) -> usize {
 }
 
 /// The default seed of the samples.
-pub const DEFAULT_SEED: u64 = 0x006b_6c65_6d73;
+pub(super) const DEFAULT_SEED: u64 = 0x006b_6c65_6d73;
 
 /// brtf's light vector (pointing towards the source) for the point `p`
 /// of an incident patch, `p` on the +z hemisphere as
@@ -71,7 +71,7 @@ pub fn light_vector(side: Side, p: DVec3) -> DVec3 {
 /// patch: reflection leaves on the lit side, transmission on the other,
 /// at the same azimuth. Lit from the front, reflection (θ, φ) is `p` and
 /// transmission is (180° − θ, φ); lit from the back, both mirrored.
-pub fn view_vector(side: Side, transmission: bool, p: DVec3) -> DVec3 {
+pub(super) fn view_vector(side: Side, transmission: bool, p: DVec3) -> DVec3 {
     let on_front = (side == Side::Front) != transmission;
     if on_front {
         p
@@ -240,7 +240,7 @@ fn radical_inverse(mut k: u64, base: u64) -> f64 {
 /// The point of `patch` at (u, v) in the unit square, uniform in
 /// projected solid angle: cos² θ linear in u, φ linear in v (the mapping
 /// of [`KlemsPatch::stratified_directions`](super::KlemsPatch::stratified_directions)).
-pub fn patch_point(patch: &super::KlemsPatch, u: f64, v: f64) -> DVec3 {
+pub(super) fn patch_point(patch: &super::KlemsPatch, u: f64, v: f64) -> DVec3 {
     let (lo, hi) = patch.theta_bounds_deg;
     let c2_top = lo.to_radians().cos().powi(2);
     let c2_bottom = hi.to_radians().cos().powi(2);

@@ -16,7 +16,7 @@ use std::fmt::Write;
 use super::{KlemsBand, KlemsBasis, KlemsDirection};
 
 /// The schema location written in the root element.
-pub const SCHEMA_LOCATION: &str = "http://windows.lbl.gov BSDF-v1.7.5.xsd";
+pub(super) const SCHEMA_LOCATION: &str = "http://windows.lbl.gov BSDF-v1.7.5.xsd";
 
 /// The header of a written file.
 #[derive(Debug, Clone, PartialEq)]

@@ -399,7 +399,7 @@ fn shorten(text: &str) -> String {
 }
 
 /// Tolerance (degrees) when comparing incidences from two sources.
-pub const INCIDENCE_TOLERANCE_DEG: f64 = 1e-3;
+pub(crate) const INCIDENCE_TOLERANCE_DEG: f64 = 1e-3;
 
 /// Brings an incident angle pair into θ ∈ [0, 180], φ ∈ [0, 360).
 /// A negative θ (in-plane signed convention, `-15+0`) means (|θ|, φ + 180°).

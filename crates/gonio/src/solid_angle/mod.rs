@@ -33,9 +33,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::measurement::{Hemisphere, Measurement, Sample};
 
-pub use voronoi::{
-    DISK_RADIUS, disk_voronoi_areas, project, reference_disk_voronoi_areas,
-};
+pub use voronoi::{DISK_RADIUS, disk_voronoi_areas, project, reference_disk_voronoi_areas};
 
 /// Where a set of solid angles came from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]

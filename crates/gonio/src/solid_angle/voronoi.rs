@@ -633,7 +633,7 @@ fn dist2(a: [f64; 2], b: [f64; 2]) -> f64 {
 
 /// Signed area of `polygon ∩ disk(0, radius)` (positive for
 /// counter-clockwise polygons).
-pub fn disk_polygon_area(polygon: &[[f64; 2]], radius: f64) -> f64 {
+pub(super) fn disk_polygon_area(polygon: &[[f64; 2]], radius: f64) -> f64 {
     let n = polygon.len();
     let r2 = radius * radius;
     if polygon.iter().all(|p| p[0] * p[0] + p[1] * p[1] <= r2) {

@@ -13,7 +13,7 @@ use plotters::prelude::*;
 const LINE_STEPS: usize = 180;
 
 /// The fitted parameters over φ_in, a panel per parameter, a line per ring.
-pub struct AzimuthChart<'a> {
+pub(crate) struct AzimuthChart<'a> {
     /// The fit; its table must follow φ_in ([`AzimuthChart::applies`]).
     pub result: &'a FitResult,
     /// Chart title.
@@ -22,7 +22,7 @@ pub struct AzimuthChart<'a> {
 
 impl AzimuthChart<'_> {
     /// True when the fit's table follows φ_in.
-    pub fn applies(result: &FitResult) -> bool {
+    pub(crate) fn applies(result: &FitResult) -> bool {
         result
             .table
             .as_ref()

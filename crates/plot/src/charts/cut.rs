@@ -56,7 +56,7 @@ fn cut_axes<'a, DB: DrawingBackend>(
 }
 
 /// The cut geometry of one incidence.
-pub struct Plane {
+pub(crate) struct Plane {
     /// Unit vector towards the mirror azimuth, horizontal.
     mirror_axis: DVec3,
     /// Normal of the plane of incidence.
@@ -65,7 +65,7 @@ pub struct Plane {
 
 impl Plane {
     /// The plane of incidence of `inc`.
-    pub fn of(inc: &Incidence) -> Plane {
+    pub(crate) fn of(inc: &Incidence) -> Plane {
         let phi = inc.phi_in.to_radians();
         Plane {
             mirror_axis: DVec3::new(-phi.cos(), -phi.sin(), 0.0),
@@ -74,24 +74,24 @@ impl Plane {
     }
 
     /// Signed in-plane angle of `v`, degrees (see the module docs).
-    pub fn x_of(&self, v: DVec3) -> f64 {
+    pub(crate) fn x_of(&self, v: DVec3) -> f64 {
         v.dot(self.mirror_axis).atan2(v.z).to_degrees()
     }
 
     /// Angle between `v` and the plane, degrees.
-    pub fn offset(&self, v: DVec3) -> f64 {
+    pub(crate) fn offset(&self, v: DVec3) -> f64 {
         v.dot(self.normal).abs().clamp(0.0, 1.0).asin().to_degrees()
     }
 
     /// The in-plane direction at signed angle `x_deg`.
-    pub fn direction(&self, x_deg: f64) -> DVec3 {
+    pub(crate) fn direction(&self, x_deg: f64) -> DVec3 {
         let (s, c) = x_deg.to_radians().sin_cos();
         self.mirror_axis * s + DVec3::Z * c
     }
 }
 
 /// The samples of a cut, with the tolerance used.
-pub struct CutData<'a> {
+pub(crate) struct CutData<'a> {
     /// Plane tolerance in degrees.
     pub tolerance: f64,
     /// `(x, sample)` for samples within the tolerance.
@@ -106,7 +106,7 @@ impl<'a> CutData<'a> {
     /// Picks the samples near the plane and evaluates the model along it.
     /// Made once per incidence and tolerance: the cut's SVG and PNG and the
     /// chart of all cuts share it.
-    pub fn of(inc: &'a Incidence, tolerance: Option<f64>) -> CutData<'a> {
+    pub(crate) fn of(inc: &'a Incidence, tolerance: Option<f64>) -> CutData<'a> {
         let made = inc.cut(tolerance, || CutData::make(inc, tolerance));
         CutData {
             tolerance: made.tolerance,
@@ -202,7 +202,7 @@ impl<'a> CutData<'a> {
     }
 
     /// x intervals that the selections removed from the fit.
-    pub fn masked_ranges(&self, inc: &Incidence) -> Vec<(f64, f64)> {
+    pub(crate) fn masked_ranges(&self, inc: &Incidence) -> Vec<(f64, f64)> {
         let mut ranges = Vec::new();
         if let Some(m) = inc.beam_mask() {
             ranges.push((-inc.theta_in - m, -inc.theta_in + m));
@@ -225,7 +225,7 @@ impl<'a> CutData<'a> {
 }
 
 /// The in-plane cut of one incidence.
-pub struct CutChart<'a> {
+pub(crate) struct CutChart<'a> {
     /// The incidence.
     pub inc: &'a Incidence,
     /// Chart title.
@@ -344,7 +344,7 @@ impl Chart for CutChart<'_> {
 }
 
 /// Every incidence's cut in one chart, one colour per incidence.
-pub struct CutsChart<'a> {
+pub(crate) struct CutsChart<'a> {
     /// The incidences with data.
     pub incs: Vec<&'a Incidence>,
     /// Chart title.

@@ -455,7 +455,7 @@ impl<'a> MapChart<'a> {
 
 /// Ratios labelled on a colour bar that ends at `k` and `1/k`: round
 /// numbers, spread out on the log scale, mirrored below 1.
-pub fn bar_ticks(k: f64) -> Vec<f64> {
+pub(crate) fn bar_ticks(k: f64) -> Vec<f64> {
     const NICE: [f64; 13] = [
         1.05, 1.1, 1.2, 1.5, 2.0, 3.0, 5.0, 10.0, 20.0, 30.0, 50.0, 100.0, 1000.0,
     ];

@@ -6,10 +6,10 @@
 //! * [`azimuth`]: over φ_in, the parameters of each θ_in ring, for tables
 //!   that follow φ_in (anisotropic types fitted to Klems XML).
 
-pub mod azimuth;
-pub mod cut;
-pub mod map;
-pub mod theta;
+pub(crate) mod azimuth;
+pub(crate) mod cut;
+pub(crate) mod map;
+pub(crate) mod theta;
 
 use crate::figure::{Area, FONT, OrMsg};
 use plotters::chart::{MeshStyle, SeriesLabelStyle};
@@ -20,10 +20,10 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 /// Font sizes in pixels.
-pub const TITLE: f64 = 22.0;
-pub const LABEL: f64 = 17.0;
-pub const TICK: f64 = 14.0;
-pub const SMALL: f64 = 13.0;
+pub(crate) const TITLE: f64 = 22.0;
+pub(crate) const LABEL: f64 = 17.0;
+pub(crate) const TICK: f64 = 14.0;
+pub(crate) const SMALL: f64 = 13.0;
 
 /// Grid lines: light enough not to compete with the data.
 const GRID: RGBColor = RGBColor(226, 226, 226);
@@ -31,10 +31,10 @@ const GRID: RGBColor = RGBColor(226, 226, 226);
 const LEGEND_SAMPLE: i32 = 20;
 
 /// A Cartesian chart over coordinates `X` × `Y`, being drawn.
-pub type CartesianChart<'a, DB, X, Y> = ChartContext<'a, DB, Cartesian2d<X, Y>>;
+pub(crate) type CartesianChart<'a, DB, X, Y> = ChartContext<'a, DB, Cartesian2d<X, Y>>;
 
 /// Margins and label areas around the plot of a Cartesian chart, in pixels.
-pub struct Frame {
+pub(crate) struct Frame {
     margin: u32,
     /// Wider than `margin`, so that the last x tick label fits.
     margin_right: u32,
@@ -44,14 +44,14 @@ pub struct Frame {
 
 impl Frame {
     /// A chart that fills its file.
-    pub const FULL: Frame = Frame {
+    pub(crate) const FULL: Frame = Frame {
         margin: 14,
         margin_right: 28,
         x_label_area: 52,
         y_label_area: 84,
     };
     /// One of several panels in a file: tighter, as they sit side by side.
-    pub const PANEL: Frame = Frame {
+    pub(crate) const PANEL: Frame = Frame {
         margin: 12,
         margin_right: 24,
         x_label_area: 46,
@@ -59,7 +59,7 @@ impl Frame {
     };
 
     /// A Cartesian chart over `x` × `y` in `area`, within this frame.
-    pub fn chart<'a, DB: DrawingBackend, X: AsRangedCoord, Y: AsRangedCoord>(
+    pub(crate) fn chart<'a, DB: DrawingBackend, X: AsRangedCoord, Y: AsRangedCoord>(
         &self,
         area: &'a Area<DB>,
         x: X,
@@ -83,7 +83,7 @@ fn tick(v: &f64) -> String {
 /// The mesh of `chart` in the shared style: the axis titles, ticks labelled
 /// by [`fmt`], and a grid at the labelled ticks only. The caller adds what
 /// is particular (tick count, a linear axis's formatter) and draws it.
-pub fn mesh<'a, 'b, DB, X, Y>(
+pub(crate) fn mesh<'a, 'b, DB, X, Y>(
     chart: &'b mut CartesianChart<'a, DB, X, Y>,
     x_desc: &str,
     y_desc: &str,
@@ -108,7 +108,7 @@ where
 /// The legend of `chart`'s labelled series: upper left, framed, on white
 /// that lets the data show through a little. The caller may move or
 /// restyle it, then draws it.
-pub fn series_legend<'a, 'b, DB, CT>(
+pub(crate) fn series_legend<'a, 'b, DB, CT>(
     chart: &'b mut ChartContext<'a, DB, CT>,
 ) -> SeriesLabelStyle<'a, 'b, DB, CT>
 where
@@ -125,13 +125,13 @@ where
 }
 
 /// A legend entry's symbol for a line series: a short line in `style`.
-pub fn legend_line(style: ShapeStyle) -> impl Fn((i32, i32)) -> PathElement<(i32, i32)> {
+pub(crate) fn legend_line(style: ShapeStyle) -> impl Fn((i32, i32)) -> PathElement<(i32, i32)> {
     move |(x, y)| PathElement::new(vec![(x, y), (x + LEGEND_SAMPLE, y)], style)
 }
 
 /// A legend entry's symbol for a dashed line series (6-pixel dashes, 4
 /// apart, as the series).
-pub fn legend_dashes(
+pub(crate) fn legend_dashes(
     style: ShapeStyle,
 ) -> impl Fn((i32, i32)) -> DashedPathElement<std::vec::IntoIter<(i32, i32)>, u32> {
     move |(x, y)| DashedPathElement::new(vec![(x, y), (x + LEGEND_SAMPLE, y)], 6, 4, style)
@@ -139,13 +139,13 @@ pub fn legend_dashes(
 
 /// A legend entry's symbol for shaded ranges: a swatch as long as a line
 /// sample.
-pub fn legend_swatch(style: ShapeStyle) -> impl Fn((i32, i32)) -> Rectangle<(i32, i32)> {
+pub(crate) fn legend_swatch(style: ShapeStyle) -> impl Fn((i32, i32)) -> Rectangle<(i32, i32)> {
     move |(x, y)| Rectangle::new([(x, y - 6), (x + LEGEND_SAMPLE, y + 6)], style)
 }
 
 /// A legend entry's symbol for circle markers of `radius` pixels, centred
 /// where a line sample would be.
-pub fn legend_circle(
+pub(crate) fn legend_circle(
     radius: i32,
     style: ShapeStyle,
 ) -> impl Fn((i32, i32)) -> Circle<(i32, i32), i32> {
@@ -154,7 +154,7 @@ pub fn legend_circle(
 
 /// A legend entry's symbol for triangle markers of `size` pixels, centred
 /// where a line sample would be.
-pub fn legend_triangle(
+pub(crate) fn legend_triangle(
     size: i32,
     style: ShapeStyle,
 ) -> impl Fn((i32, i32)) -> TriangleMarker<(i32, i32), i32> {
@@ -162,24 +162,24 @@ pub fn legend_triangle(
 }
 
 /// A text style of `size` pixels in `colour`, anchored at `h`, `v`.
-pub fn text(size: f64, colour: &RGBColor, h: HPos, v: VPos) -> TextStyle<'static> {
+pub(crate) fn text(size: f64, colour: &RGBColor, h: HPos, v: VPos) -> TextStyle<'static> {
     (FONT, size).into_font().color(colour).pos(Pos::new(h, v))
 }
 
 /// Plain black text anchored at its left and vertical centre.
-pub fn left(size: f64) -> TextStyle<'static> {
+pub(crate) fn left(size: f64) -> TextStyle<'static> {
     text(size, &BLACK, HPos::Left, VPos::Center)
 }
 
 /// Draws the chart's title centred at the top and returns the area below.
-pub fn titled<DB: DrawingBackend>(root: &Area<DB>, title: &str) -> Result<Area<DB>, String> {
+pub(crate) fn titled<DB: DrawingBackend>(root: &Area<DB>, title: &str) -> Result<Area<DB>, String> {
     root.titled(title, (FONT, TITLE).into_font().color(&BLACK))
         .msg()
 }
 
 /// A tick label: integers as such, otherwise up to three significant
 /// digits, with an exponent outside [1e-3, 1e4).
-pub fn fmt(v: f64) -> String {
+pub(crate) fn fmt(v: f64) -> String {
     if v == 0.0 || !v.is_finite() {
         return format!("{v}");
     }
@@ -203,7 +203,7 @@ pub fn fmt(v: f64) -> String {
 /// A tick formatter for a linear axis over `[lo, hi]`: as many decimals
 /// as the tick spacing needs, trailing zeros trimmed; an exponent for very
 /// large or very small magnitudes.
-pub fn lin_fmt(lo: f64, hi: f64) -> impl Fn(&f64) -> String {
+pub(crate) fn lin_fmt(lo: f64, hi: f64) -> impl Fn(&f64) -> String {
     let step = ((hi - lo).abs() / 10.0).max(1e-300);
     let big = lo.abs().max(hi.abs());
     let decimals = (-step.log10()).ceil().max(0.0) as usize + 1;
@@ -225,7 +225,7 @@ pub fn lin_fmt(lo: f64, hi: f64) -> impl Fn(&f64) -> String {
 
 /// Range `[lo, hi]` of a log axis that shows every positive value in
 /// `values`, with a margin, and at most `decades` decades below the top.
-pub fn log_range(values: impl Iterator<Item = f64>, decades: f64) -> (f64, f64) {
+pub(crate) fn log_range(values: impl Iterator<Item = f64>, decades: f64) -> (f64, f64) {
     let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
     for v in values.filter(|v| v.is_finite() && *v > 0.0) {
         lo = lo.min(v);
@@ -244,7 +244,7 @@ pub fn log_range(values: impl Iterator<Item = f64>, decades: f64) -> (f64, f64) 
 }
 
 /// Range of a linear axis over `values` with 8% margins (never empty).
-pub fn lin_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
+pub(crate) fn lin_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for v in values.filter(|v| v.is_finite()) {
         lo = lo.min(v);
@@ -263,7 +263,7 @@ pub fn lin_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
 }
 
 /// The θ_in axis range over `thetas` (at least 10° wide).
-pub fn theta_range(thetas: &[f64]) -> (f64, f64) {
+pub(crate) fn theta_range(thetas: &[f64]) -> (f64, f64) {
     let lo = thetas.iter().copied().fold(f64::INFINITY, f64::min);
     let hi = thetas.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     if !lo.is_finite() {
@@ -274,7 +274,7 @@ pub fn theta_range(thetas: &[f64]) -> (f64, f64) {
 }
 
 /// `θ_in = 30°` (φ_in appended when not 0).
-pub fn incidence_label(theta_in: f64, phi_in: f64) -> String {
+pub(crate) fn incidence_label(theta_in: f64, phi_in: f64) -> String {
     if phi_in == 0.0 {
         format!("θ_in = {}°", crate::prepare::num(theta_in))
     } else {

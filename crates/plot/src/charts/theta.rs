@@ -53,7 +53,7 @@ fn theta_axes<'a, DB: DrawingBackend>(
 
 /// Model ρ_dh and τ_dh (non-delta + delta parts) of `material` for light
 /// from (θ, φ), channel mean over `channels`, times `scale`.
-pub fn model_integrals(
+pub(crate) fn model_integrals(
     material: &Material,
     result: &FitResult,
     theta: f64,
@@ -71,7 +71,7 @@ pub fn model_integrals(
 
 /// Hemispherical integrals of one incidence (index 0: front, 1: back).
 #[derive(Debug, Clone, PartialEq)]
-pub struct Integrals {
+pub(crate) struct Integrals {
     /// θ_in, degrees.
     pub theta: f64,
     /// Data over the fitted samples (None without data or samples there).
@@ -83,7 +83,7 @@ pub struct Integrals {
 }
 
 /// The integrals of every incidence; `incs[k]` is incidence k's data, if read.
-pub fn integrals(result: &FitResult, incs: &[Option<&Incidence>]) -> Vec<Integrals> {
+pub(crate) fn integrals(result: &FitResult, incs: &[Option<&Incidence>]) -> Vec<Integrals> {
     result
         .incidences
         .iter()
@@ -145,7 +145,7 @@ struct Panel {
 }
 
 /// Parameters over θ_in, one panel per parameter (colour channels share one).
-pub struct ParamsChart<'a> {
+pub(crate) struct ParamsChart<'a> {
     /// The fit.
     pub result: &'a FitResult,
     /// The data unit (for the free scale's unit).
@@ -431,7 +431,7 @@ impl Chart for ParamsChart<'_> {
 type CurvePoint = (f64, Option<[f64; 2]>, Option<[f64; 2]>);
 
 /// ρ_dh (and τ_dh) over θ_in: data against model.
-pub struct RhoChart<'a> {
+pub(crate) struct RhoChart<'a> {
     /// The fit.
     pub result: &'a FitResult,
     /// Incidence k's data, if read.
@@ -625,7 +625,7 @@ impl Chart for RhoChart<'_> {
 }
 
 /// The error of every incidence's fit.
-pub struct RmsChart<'a> {
+pub(crate) struct RmsChart<'a> {
     /// The fit.
     pub result: &'a FitResult,
     /// Median |model ÷ data − 1| per incidence (None without data).

@@ -77,7 +77,7 @@ pub(crate) struct CalModel<'a> {
 
 impl CalModel<'_> {
     /// The `.cal` text. `header` lines become a leading comment.
-    pub fn text(&self, header: &[String]) -> String {
+    pub(super) fn text(&self, header: &[String]) -> String {
         let mut o = String::new();
         o += "{\n";
         for line in header {

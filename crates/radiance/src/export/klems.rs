@@ -17,10 +17,10 @@
 use std::path::{Path, PathBuf};
 
 use brtf_fit::{FitResult, azimuth_from_u};
-use brtf_gonio::klems::{SampleOptions, SideMatrices, band_values, side_matrices};
 use brtf_gonio::klems::{
     KlemsBand, KlemsBasis, KlemsDirection, KlemsWriteBlock, KlemsWriteHeader, Side, to_klems_xml,
 };
+use brtf_gonio::klems::{SampleOptions, SideMatrices, band_values, side_matrices};
 use brtf_model::{Bsdf, EvalOptions, Material, Rgb};
 
 /// Where the Solar band comes from.
@@ -360,12 +360,7 @@ fn build(
     for (side, model) in &sides {
         let matrices = match computed.first() {
             Some((_, front)) if model.same_as_front => front.clone(),
-            _ => side_matrices(
-                basis,
-                &model.bsdfs,
-                model.transmitting,
-                options.sampling,
-            ),
+            _ => side_matrices(basis, &model.bsdfs, model.transmitting, options.sampling),
         };
         computed.push((*side, matrices));
     }

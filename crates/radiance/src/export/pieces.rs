@@ -21,7 +21,7 @@ pub(crate) struct Segment {
 
 impl Segment {
     /// The cubic at `theta` (degrees).
-    pub fn eval(&self, theta: f64) -> f64 {
+    pub(super) fn eval(&self, theta: f64) -> f64 {
         let s = theta - self.start;
         let [a0, a1, a2, a3] = self.coef;
         a0 + s * (a1 + s * (a2 + s * a3))
@@ -47,7 +47,7 @@ impl Pieces {
     /// The segments of `table`: exact cubics when the table is piecewise
     /// cubic between its nodes (checked at three more points per segment),
     /// otherwise straight lines every [`FALLBACK_STEP`] degrees.
-    pub fn of(table: &ParamTable) -> Pieces {
+    pub(super) fn of(table: &ParamTable) -> Pieces {
         let exact = Pieces::cubic(table, &table.theta_in);
         if exact.reproduces(table) {
             exact
@@ -136,7 +136,7 @@ impl Pieces {
     /// Parameter `param` at `theta`, clamped to the table's range like
     /// [`ParamTable::args_at`].
     #[cfg(test)]
-    pub fn eval(&self, param: usize, theta: f64) -> f64 {
+    pub(super) fn eval(&self, param: usize, theta: f64) -> f64 {
         let (lo, hi) = (self.nodes[0], self.nodes[self.nodes.len() - 1]);
         let t = theta.clamp(lo, hi);
         let segs = &self.segments[param];
