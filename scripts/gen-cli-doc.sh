@@ -17,12 +17,7 @@ brtf=target/release/brtf
     echo "every error, usage errors and out-of-range values included. Files are written"
     echo "to a temporary file and renamed, and a fit folder is written beside its target"
     echo "and swapped in as a whole, under a lock; see \`docs/outputs.md\` for output"
-    echo "folders, \`--force\` and the option checks. On Linux with glibc, \`brtf\`"
-    echo "starts itself once more with \`GLIBC_TUNABLES\` set for malloc (huge pages,"
-    echo "no trimming; \`docs/benchmarks.md\`, \"The allocator\"), unless that variable"
-    echo "already holds a \`glibc.malloc.\` setting: set one (for example"
-    echo "\`GLIBC_TUNABLES=glibc.malloc.hugetlb=0\`) to keep glibc's defaults, as under"
-    echo "valgrind."
+    echo "folders, \`--force\` and the option checks."
     echo
     echo '```'
     "$brtf" --help

@@ -29,7 +29,7 @@ enum Command {
     Eval(cmd::eval::EvalArgs),
     /// Directional-hemispherical reflectance and transmittance of a material.
     Albedo(cmd::albedo::AlbedoArgs),
-    /// Summarise measurement files (.mpc or Mountain).
+    /// Summarise measurement files (.mpc, pab-opto Mountain or Klems BSDF XML).
     Info(cmd::info::InfoArgs),
     /// Write synthetic measurement files with realistic instrument effects.
     Synth(cmd::synth::SynthArgs),
@@ -45,55 +45,18 @@ enum Command {
     Plot(cmd::plot::PlotArgs),
 }
 
-/// glibc's malloc settings for brtf's runs: heap memory on transparent
-/// huge pages, and freed memory kept for reuse rather than handed back to
-/// the kernel. A run allocates and frees tens of MB in phases; with the
-/// defaults each phase faulted its memory in again 4 KiB at a time (18.6k
-/// page faults and a quarter of the CPU time in the kernel on a lean
-/// golden_paper fit), and mimalloc, tried instead, zeroed ~100 MB of huge
-/// pages. See docs/benchmarks.md ("The allocator").
-const MALLOC_TUNABLES: &str = "glibc.malloc.hugetlb=1:\
-                               glibc.malloc.trim_threshold=2147483647:\
-                               glibc.malloc.top_pad=67108864";
-
-/// glibc reads its tunables only when a process starts: unless they are
-/// set (by us or by the user, whose own malloc tunables win), run this
-/// same program again with them, in place of this process. If that
-/// cannot be done the run goes on with the defaults.
-#[cfg(all(target_os = "linux", target_env = "gnu"))]
-fn with_tuned_malloc() {
-    use std::os::unix::process::CommandExt;
-    let current = std::env::var_os("GLIBC_TUNABLES");
-    if current
-        .as_ref()
-        .is_some_and(|v| v.to_string_lossy().contains("glibc.malloc."))
-    {
-        return;
-    }
-    let Ok(exe) = std::env::current_exe() else {
-        return;
-    };
-    let tunables = match current {
-        Some(v) if !v.is_empty() => format!("{}:{MALLOC_TUNABLES}", v.to_string_lossy()),
-        _ => MALLOC_TUNABLES.to_string(),
-    };
-    let mut args = std::env::args_os();
-    let mut again = std::process::Command::new(exe);
-    if let Some(name) = args.next() {
-        again.arg0(name);
-    }
-    // `exec` returns only when it failed.
-    let _ = again.args(args).env("GLIBC_TUNABLES", tunables).exec();
-}
-
-#[cfg(not(all(target_os = "linux", target_env = "gnu")))]
-fn with_tuned_malloc() {}
+/// The allocator: mimalloc keeps freed memory for the next phase of a run
+/// and backs it with large pages, where glibc's malloc by default hands
+/// big blocks back to the kernel and faults them in again 4 KiB at a time
+/// (a lean golden_paper fit: 16.9k page faults and ~40% more wall time;
+/// docs/benchmarks.md, "The allocator").
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 /// Exit codes (docs/outputs.md): 0 on success and when the reader of
 /// standard output has gone (as ripgrep), 1 on every error, the command
 /// line's included; `--help` and `--version` exit 0.
 fn main() {
-    with_tuned_malloc();
     let cli = Cli::try_parse().unwrap_or_else(|e| {
         let _ = e.print();
         std::process::exit(if e.use_stderr() { 1 } else { 0 })

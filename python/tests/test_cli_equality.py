@@ -156,6 +156,21 @@ def test_save_writes_the_folder_brtf_fit_writes(cli, tmp_path, alu):
 
     for name in ("alu-ggx.rad", "alu-ggx-theta.rad", "alu-ggx-theta.cal"):
         assert body(tmp_path / "py" / name) == body(tmp_path / "cli" / name)
+    # The rest is the same bytes: params.csv, every plot, the preview scene.
+    same = [f for f in cli_files if f.startswith("plots/") or f in ("params.csv", "alu-ggx-preview.rad")]
+    assert len(same) > 20
+    for name in same:
+        assert (tmp_path / "py" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes(), name
+    # fit.json: the same fit, but for the provenance and the run times.
+    def fit_json(folder):
+        fit = json.loads((folder / "fit.json").read_text())
+        del fit["provenance"]["created"], fit["provenance"]["command_line"]
+        for report in fit["incidences"] + [fit["global"]]:
+            del report["elapsed_ms"]
+        fit["outputs"] = [o for o in fit["outputs"] if o["path"] in same]
+        return fit
+
+    assert fit_json(tmp_path / "py") == fit_json(tmp_path / "cli")
     # And `brtf export` reads the Python-written folder.
     run_cli(cli, "export", tmp_path / "py", "--out", tmp_path / "re")
     assert body(tmp_path / "re" / "alu-ggx.rad") == body(tmp_path / "py" / "alu-ggx.rad")

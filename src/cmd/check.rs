@@ -1,10 +1,9 @@
 //! `brtf check DIR`: renders a fit through the virtual gonio-photometer
 //! ([`brtf_trace::check`]) and writes the comparison to `DIR/check.csv`.
 
-use super::output::write_atomic;
 use super::shared::with_jobs;
 use anyhow::Result;
-use brtf_trace::{CheckOptions, check_fit};
+use brtf_trace::CheckOptions;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -61,15 +60,10 @@ pub(crate) fn run(args: CheckArgs) -> Result<()> {
         seed: args.seed,
         search_dirs: args.search_dirs.clone(),
     };
-    options.validate()?;
-    let fit = brtf_workflow::read_fit(&args.dir)?;
-    let report = with_jobs(args.jobs, || check_fit(&fit, &args.dir, &options))??;
+    let (report, out) = with_jobs(args.jobs, || {
+        brtf_workflow::check_folder(&args.dir, &options, args.out.as_deref())
+    })??;
     super::output::print(&report.to_string())?;
-    let out = args
-        .out
-        .clone()
-        .unwrap_or_else(|| args.dir.join("check.csv"));
-    write_atomic(&out, report.csv()?.as_bytes())?;
     say!("brtf check: wrote {}", out.display());
     Ok(())
 }

@@ -2,7 +2,7 @@
 
 use super::material::MaterialArgs;
 use super::shared::{csv_stdout, write_numbers};
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use brtf_model::direction;
 use clap::Args;
 use std::io::BufRead;
@@ -29,25 +29,8 @@ pub(crate) fn run(args: EvalArgs) -> Result<()> {
     for (index, line) in stdin.lock().lines().enumerate() {
         let number = index + 1;
         let line = line.with_context(|| format!("<stdin>:{number}: cannot read"))?;
-        let trimmed = line.trim();
-        if trimmed.is_empty() || trimmed.starts_with('#') {
+        let Some((theta, phi)) = brtf_workflow::parse_direction_line(&line, number)? else {
             continue;
-        }
-        let fields: Vec<&str> = trimmed.split(',').map(str::trim).collect();
-        if fields.len() != 2 {
-            bail!(
-                "<stdin>:{number}: expected `theta_out,phi_out`, found {} fields",
-                fields.len()
-            );
-        }
-        let parsed: Vec<Option<f64>> = fields.iter().map(|f| f.parse::<f64>().ok()).collect();
-        let (theta, phi) = match (parsed[0], parsed[1]) {
-            (Some(t), Some(p)) if t.is_finite() && p.is_finite() => (t, p),
-            // A header line such as `theta_out,phi_out`.
-            _ if number == 1 && parsed.iter().all(Option::is_none) => continue,
-            _ => bail!(
-                "<stdin>:{number}: `{trimmed}` is not two numbers (theta_out,phi_out in degrees)"
-            ),
         };
         let f = bsdf.eval(l, direction(theta, phi));
         write_numbers(&mut out, &[theta, phi, f[0], f[1], f[2]])?;

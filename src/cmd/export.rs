@@ -3,13 +3,14 @@
 //! with `--klems`, a Klems BSDF XML file instead, from a fit folder or
 //! (`--material`) from a static material.
 
-use super::material::{FormulaArgs, load_material};
+use super::material::FormulaArgs;
 use super::output::print;
 use super::shared::words;
 use anyhow::{Context, Result};
 use brtf_gonio::klems::BasisSize;
 use brtf_radiance::export::ExportOptions;
-use brtf_radiance::export::klems::{self, KlemsOptions, SolarBand};
+use brtf_radiance::export::klems::{KlemsOptions, SolarBand};
+use brtf_workflow::read_material_file;
 use clap::Args;
 use std::path::{Path, PathBuf};
 
@@ -86,30 +87,16 @@ pub(crate) fn run(args: ExportArgs) -> Result<()> {
         return run_klems(&args, basis);
     }
     let dir = args.dir.as_ref().context("give the fit folder")?;
-    if let Some(at) = args.at {
-        anyhow::ensure!(
-            (0.0..90.0).contains(&at),
-            "--at {at}: out of range; allowed: 0 ≤ θ_in < 90 degrees"
-        );
-    }
-    let result = brtf_workflow::read_fit(dir)?;
     let options = ExportOptions {
         name: args.name.clone(),
         at: args.at,
         theta_dependent: !args.static_only,
         preview: !args.no_preview,
     };
+    options.validate()?;
+    let result = brtf_workflow::read_fit(dir)?;
     let out = args.out.as_ref().unwrap_or(dir);
-    let written = brtf_workflow::export_into(out, &result, &options)?;
-    for note in &written.notes {
-        say!("note: {note}");
-    }
-    let lines: String = written
-        .files
-        .iter()
-        .map(|f| format!("wrote {}\n", f.display()))
-        .collect();
-    print(&lines)
+    print_written(&brtf_workflow::export_into(out, &result, &options)?)
 }
 
 /// `brtf export DIR --klems` or `brtf export --klems --material M.rad`.
@@ -123,7 +110,7 @@ fn run_klems(args: &ExportArgs, basis: BasisSize) -> Result<()> {
         None => SolarBand::None,
         Some("visible") => SolarBand::ReuseVisible,
         Some(file) => SolarBand::Material {
-            material: load_material(Path::new(file), None)
+            material: read_material_file(Path::new(file), None)
                 .with_context(|| format!("--solar {file}"))?
                 .1,
             source: file.to_string(),
@@ -146,48 +133,35 @@ fn run_klems(args: &ExportArgs, basis: BasisSize) -> Result<()> {
             .context("give the fit folder or --material")?;
         let (stem, export) =
             brtf_workflow::klems_of_fit_folder(dir, args.name.as_deref(), options)?;
-        let path =
-            brtf_workflow::write_klems_into(args.out.as_ref().unwrap_or(dir), &stem, &export)?;
-        for note in &export.notes {
-            say!("note: {note}");
-        }
-        return print(&format!("wrote {}\n", path.display()));
+        let out = args.out.as_ref().unwrap_or(dir);
+        let files = vec![brtf_workflow::write_klems_into(out, &stem, &export)?];
+        let notes = export.notes;
+        return print_written(&brtf_workflow::Amended { files, notes });
     };
     anyhow::ensure!(
         args.dir.is_none(),
         "give either a fit folder or --material, not both"
     );
-    let (name, material) = load_material(material_path, args.name.as_deref())?;
-    let bytes = std::fs::read(material_path)
-        .with_context(|| format!("cannot read {}", material_path.display()))?;
-    let eval = k.formula.options();
-    eval.validate()?;
-    options.name = name.clone();
-    let export = klems::klems_from_material(
-        &material,
-        &eval,
-        &material_path.display().to_string(),
-        &brtf_io::sha256_hex(&bytes),
-        &options,
+    let written = brtf_workflow::export_klems_of_material(
+        material_path,
+        args.name.as_deref(),
+        &k.formula.options(),
+        options,
+        args.out.as_deref(),
+        k.klems_cal,
     )?;
-    let out = args
-        .out
-        .clone()
-        .or_else(|| material_path.parent().map(Path::to_path_buf))
-        .unwrap_or_default();
-    brtf_io::ensure_folder(&out)?;
-    let path = out.join(format!("{name}.xml"));
-    klems::write_klems(&path, &export)?;
-    let mut lines = format!("wrote {}\n", path.display());
-    if k.klems_cal {
-        let cal = brtf_radiance::export::klems_cal::bsdf_function_cal(&material)
-            .map_err(|e| anyhow::anyhow!("--klems-cal: {e}"))?;
-        let cal_path = out.join(format!("{name}-bsdf2klems.cal"));
-        brtf_io::write_atomic(&cal_path, cal.as_bytes())?;
-        lines += &format!("wrote {}\n", cal_path.display());
-    }
-    for note in &export.notes {
+    print_written(&written)
+}
+
+/// Prints the notes, then a `wrote …` line per file.
+fn print_written(written: &brtf_workflow::Amended) -> Result<()> {
+    for note in &written.notes {
         say!("note: {note}");
     }
+    let lines: String = written
+        .files
+        .iter()
+        .map(|f| format!("wrote {}\n", f.display()))
+        .collect();
     print(&lines)
 }

@@ -1,10 +1,11 @@
 //! Options shared by every command that evaluates a material file.
 
 use super::shared::words;
-use anyhow::{Context, Result};
+use anyhow::Result;
 use brtf_model::{Bsdf, EvalOptions, Material, Variant, parse_fresnel_k};
+use brtf_workflow::read_material_file;
 use clap::Args;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 #[derive(Args, Debug, Clone)]
 pub(crate) struct MaterialArgs {
@@ -47,19 +48,10 @@ impl FormulaArgs {
     }
 }
 
-/// Reads a Radiance file and picks the material `name` (or its only one).
-pub(crate) fn load_material(path: &Path, name: Option<&str>) -> Result<(String, Material)> {
-    let shown = path.display().to_string();
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("cannot read material file {shown}"))?;
-    let primitives = brtf_radiance::parse_primitives(&text, &shown)?;
-    Ok(brtf_radiance::select_material(&primitives, name, &shown)?)
-}
-
 impl MaterialArgs {
     /// Reads the file and picks the material.
     pub(crate) fn load(&self) -> Result<(String, Material)> {
-        load_material(&self.material, self.name.as_deref())
+        Ok(read_material_file(&self.material, self.name.as_deref())?)
     }
 
     pub(crate) fn options(&self) -> Result<EvalOptions> {

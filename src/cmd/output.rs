@@ -5,16 +5,6 @@
 
 use anyhow::Result;
 use std::io::Write;
-use std::path::Path;
-
-/// Writes `bytes` to `path` atomically (same-folder temporary + rename),
-/// creating its folder when missing.
-pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    if let Some(folder) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
-        brtf_io::ensure_folder(folder)?;
-    }
-    Ok(brtf_io::write_atomic(path, bytes)?)
-}
 
 /// Standard output whose errors name it and keep their kind (so that
 /// [`is_broken_pipe`] can tell a reader that left from a failure).

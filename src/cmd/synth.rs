@@ -1,10 +1,9 @@
 //! `brtf synth`: synthetic measurement files with instrument effects.
 
 use super::material::{FormulaArgs, MaterialArgs};
-use super::output::write_atomic;
 use super::shared::words;
 use anyhow::{Result, bail};
-use brtf_gonio::synth::{GroundTruth, Instrument, Layout, SYNTH_MARKER, SynthSet};
+use brtf_gonio::synth::{GroundTruth, Instrument, Layout, SynthSet};
 use brtf_gonio::{Channels, SourceFormat};
 use clap::Args;
 use std::path::PathBuf;
@@ -101,20 +100,7 @@ pub(crate) fn run(args: SynthArgs) -> Result<()> {
             GroundTruth::Model(material.bsdf()?)
         }
         (None, Some(f0)) => {
-            let (Ok(f0), Ok(diffuse)) = (
-                <[f64; 3]>::try_from(&f0[..]),
-                <[f64; 3]>::try_from(&args.ggx_diffuse[..]),
-            ) else {
-                bail!("--ggx and --ggx-diffuse take three numbers r,g,b");
-            };
-            if !(args.ggx_alpha > 0.0 && args.ggx_alpha <= 1.0) {
-                bail!("--ggx-alpha must be in (0, 1]");
-            }
-            GroundTruth::Ggx {
-                f0,
-                alpha: args.ggx_alpha,
-                diffuse,
-            }
+            GroundTruth::ggx(f0, args.ggx_alpha, &args.ggx_diffuse).map_err(anyhow::Error::msg)?
         }
         _ => bail!("give the ground truth: --material M.rad or --ggx R,G,B"),
     };
@@ -154,16 +140,9 @@ pub(crate) fn run(args: SynthArgs) -> Result<()> {
             super::fit::command_line().join(" ")
         )],
     };
-    set.validate()?;
-    let inputs: Vec<&std::path::Path> = args.material.iter().map(|m| m.as_path()).collect();
-    for &theta in &set.theta_in {
-        let file = args.out.join(set.file_name(theta));
-        brtf_io::check_overwrite(&file, &inputs, Some(SYNTH_MARKER), args.force)?;
-    }
-    for (index, &theta) in set.theta_in.iter().enumerate() {
-        let (text, samples) = set.file_text(index).map_err(anyhow::Error::msg)?;
-        let file = args.out.join(set.file_name(theta));
-        write_atomic(&file, text.as_bytes())?;
+    let written =
+        brtf_workflow::write_synth_set(&set, &args.out, args.material.as_deref(), args.force)?;
+    for (file, samples) in written {
         say!("wrote {} ({samples} samples)", file.display());
     }
     Ok(())

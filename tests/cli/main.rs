@@ -21,6 +21,7 @@ mod many;
 mod peer;
 mod plot;
 mod render;
+mod reproduce;
 mod rtrace;
 mod safety;
 mod speed;

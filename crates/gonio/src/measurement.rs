@@ -423,6 +423,40 @@ pub struct Measurement {
 }
 
 impl Measurement {
+    /// The header's key/value pairs: `#key value` lines give `key → value`
+    /// (quotes and tabs trimmed), `.mpc` `#label:` lines followed by a value
+    /// line give `label → value`, in file order.
+    pub fn header_pairs(&self) -> Vec<(String, String)> {
+        let mut pairs = Vec::new();
+        let mut label: Option<String> = None;
+        for line in &self.header {
+            let line = line.trim();
+            let Some(body) = line.strip_prefix('#') else {
+                // An `.mpc` value line: the value of the label before it.
+                if let Some(key) = label.take() {
+                    pairs.push((key, line.to_string()));
+                }
+                continue;
+            };
+            label = None;
+            let body = body.trim();
+            if let Some(key) = body.strip_suffix(':') {
+                label = Some(key.trim().to_string());
+                continue;
+            }
+            let (key, value) = match body.find(|c: char| c.is_whitespace() || c == ':') {
+                Some(at) => (&body[..at], body[at + 1..].trim()),
+                None => (body, ""),
+            };
+            if key.is_empty() {
+                continue;
+            }
+            let value = value.trim_matches('"').replace('\t', " ");
+            pairs.push((key.to_string(), value));
+        }
+        pairs
+    }
+
     /// A measurement with no header, no `.mpc` extras and `up_phi` 0.
     pub fn new(
         format: SourceFormat,

@@ -173,7 +173,6 @@ impl Gate {
             }
         }
     }
-
 }
 
 impl std::fmt::Display for Gate {

@@ -37,6 +37,19 @@ pub enum GroundTruth {
 }
 
 impl GroundTruth {
+    /// The GGX ground truth of `--ggx R,G,B --ggx-alpha A --ggx-diffuse R,G,B`,
+    /// checked: three numbers each, 0 < α ≤ 1.
+    pub fn ggx(f0: &[f64], alpha: f64, diffuse: &[f64]) -> Result<GroundTruth, String> {
+        let (Ok(f0), Ok(diffuse)) = (<[f64; 3]>::try_from(f0), <[f64; 3]>::try_from(diffuse))
+        else {
+            return Err("--ggx and --ggx-diffuse take three numbers r,g,b".into());
+        };
+        if !(alpha > 0.0 && alpha <= 1.0) {
+            return Err("--ggx-alpha must be in (0, 1]".into());
+        }
+        Ok(GroundTruth::Ggx { f0, alpha, diffuse })
+    }
+
     /// BSDF (1/sr, no cosine) for light `l` and view `v`.
     pub fn eval(&self, l: DVec3, v: DVec3) -> [f64; 3] {
         match self {

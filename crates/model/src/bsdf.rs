@@ -702,3 +702,43 @@ struct Lobe {
     d_width_v: f64,
     passes_cutoff: bool,
 }
+
+impl Bsdf {
+    /// `out[3 i .. 3 i + 3]` = the BSDF (1/sr, RGB) for light from
+    /// (`theta_in[i]`, `phi_in[i]`) seen from (`theta_out[i]`,
+    /// `phi_out[i]`), all in degrees, as `brtf eval` computes it. All
+    /// slices have the same length; `out` is three times as long.
+    pub fn eval_degrees(
+        &self,
+        theta_in: &[f64],
+        phi_in: &[f64],
+        theta_out: &[f64],
+        phi_out: &[f64],
+        out: &mut [f64],
+    ) {
+        let rows = theta_in
+            .iter()
+            .zip(phi_in)
+            .zip(theta_out.iter().zip(phi_out));
+        for (((ti, pi), (to, po)), rgb) in rows.zip(out.chunks_exact_mut(3)) {
+            let (l, v) = (crate::direction(*ti, *pi), crate::direction(*to, *po));
+            rgb.copy_from_slice(&self.eval(l, v));
+        }
+    }
+
+    /// [`Bsdf::eval_degrees`] for one incidence and many outgoing
+    /// directions: the light direction is computed once.
+    pub fn eval_degrees_from(
+        &self,
+        theta_in: f64,
+        phi_in: f64,
+        theta_out: &[f64],
+        phi_out: &[f64],
+        out: &mut [f64],
+    ) {
+        let l = crate::direction(theta_in, phi_in);
+        for ((to, po), rgb) in theta_out.iter().zip(phi_out).zip(out.chunks_exact_mut(3)) {
+            rgb.copy_from_slice(&self.eval(l, crate::direction(*to, *po)));
+        }
+    }
+}

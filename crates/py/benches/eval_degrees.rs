@@ -1,9 +1,7 @@
 //! The Rust single-thread rate that `python/bench.py` compares
 //! `Material.eval` with: the very loop the binding calls
-//! (`src/kernel.rs`), on 10⁶ directions in degrees, metal material.
-
-#[path = "../src/kernel.rs"]
-mod kernel;
+//! (`Bsdf::eval_degrees_from` and `Bsdf::eval_degrees`), on 10⁶ directions
+//! in degrees, metal material.
 
 use brtf_model::{Bsdf, EvalOptions, Material, MaterialKind};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
@@ -34,13 +32,13 @@ fn bench(c: &mut Criterion) {
     group.sample_size(20);
     group.bench_function("metal_1e6_one_incidence", |b| {
         b.iter(|| {
-            kernel::eval_degrees_one_incidence(&bsdf, 30.0, 0.0, &theta, &phi, &mut out);
+            bsdf.eval_degrees_from(30.0, 0.0, &theta, &phi, &mut out);
             black_box(&out);
         })
     });
     group.bench_function("metal_1e6_per_row_incidence", |b| {
         b.iter(|| {
-            kernel::eval_degrees(&bsdf, &theta_in, &phi_in, &theta, &phi, &mut out);
+            bsdf.eval_degrees(&theta_in, &phi_in, &theta, &phi, &mut out);
             black_box(&out);
         })
     });

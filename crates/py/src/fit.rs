@@ -106,6 +106,39 @@ pub(crate) fn run_fit(
 /// One fit report (an incidence, or all of them at once).
 #[pyclass(module = "brtf", frozen)]
 pub struct IncidenceFit {
+    /// θ_in in degrees (the mean incidence for the all-incidence fit).
+    #[pyo3(get)]
+    theta_in: f64,
+    /// φ_in in degrees.
+    #[pyo3(get)]
+    phi_in: f64,
+    /// The file (or `all incidences`).
+    #[pyo3(get)]
+    source: String,
+    /// The material's real arguments (Radiance order).
+    #[pyo3(get)]
+    material_args: Vec<f64>,
+    /// The free scale (1 for absolute data).
+    #[pyo3(get)]
+    scale: f64,
+    /// ½ Σ (weighted residual)² at the optimum.
+    #[pyo3(get)]
+    cost: f64,
+    /// RMS relative residual.
+    #[pyo3(get)]
+    rms_rel: f64,
+    /// Samples fitted.
+    #[pyo3(get)]
+    n_points: usize,
+    /// Why the optimiser stopped.
+    #[pyo3(get)]
+    termination: String,
+    /// Did the optimiser converge?
+    #[pyo3(get)]
+    converged: bool,
+    /// The warnings, as text.
+    #[pyo3(get)]
+    warnings: Vec<String>,
     report: FitReport,
     material: Option<brtf_model::Material>,
     options: brtf_model::EvalOptions,
@@ -114,10 +147,34 @@ pub struct IncidenceFit {
 impl IncidenceFit {
     fn new(result: &FitResult, report: &FitReport) -> IncidenceFit {
         IncidenceFit {
+            theta_in: report.theta_in,
+            phi_in: report.phi_in,
+            source: report.source.clone(),
+            material_args: report.material_args.clone(),
+            scale: report.scale,
+            cost: report.cost,
+            rms_rel: report.rms_rel,
+            n_points: report.n_points,
+            termination: report.termination.label().to_string(),
+            converged: report.termination.converged(),
+            warnings: report.warnings.iter().map(|w| w.to_string()).collect(),
             material: result.material_of(report),
             options: result.options(),
             report: report.clone(),
         }
+    }
+
+    /// `name → f(parameter)` over the fitted parameters.
+    fn by_name<'py, T: IntoPyObject<'py>>(
+        &self,
+        py: Python<'py>,
+        f: impl Fn(&brtf_fit::ParamEstimate) -> T,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for p in &self.report.params {
+            d.set_item(&p.name, f(p))?;
+        }
+        Ok(d)
     }
 }
 
@@ -129,57 +186,22 @@ fn to_python<'py, T: serde::Serialize>(py: Python<'py>, value: &T) -> PyResult<B
 
 #[pymethods]
 impl IncidenceFit {
-    /// θ_in in degrees (the mean incidence for the all-incidence fit).
-    #[getter]
-    fn theta_in(&self) -> f64 {
-        self.report.theta_in
-    }
-
-    #[getter]
-    fn phi_in(&self) -> f64 {
-        self.report.phi_in
-    }
-
-    /// The file (or `all incidences`).
-    #[getter]
-    fn source(&self) -> String {
-        self.report.source.clone()
-    }
-
     /// The fitted parameters, name → value (physical units).
     #[getter]
     fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let d = PyDict::new(py);
-        for p in &self.report.params {
-            d.set_item(&p.name, p.value)?;
-        }
-        Ok(d)
+        self.by_name(py, |p| p.value)
     }
 
     /// Standard errors, name → value (None where not available).
     #[getter]
     fn stderr<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let d = PyDict::new(py);
-        for p in &self.report.params {
-            d.set_item(&p.name, p.stderr)?;
-        }
-        Ok(d)
+        self.by_name(py, |p| p.stderr)
     }
 
     /// Robust (sandwich) standard errors, name → value.
     #[getter]
     fn stderr_robust<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let d = PyDict::new(py);
-        for p in &self.report.params {
-            d.set_item(&p.name, p.stderr_robust)?;
-        }
-        Ok(d)
-    }
-
-    /// The material's real arguments (Radiance order).
-    #[getter]
-    fn material_args(&self) -> Vec<f64> {
-        self.report.material_args.clone()
+        self.by_name(py, |p| p.stderr_robust)
     }
 
     /// The fitted material, with the fit's evaluation options.
@@ -187,48 +209,6 @@ impl IncidenceFit {
     fn material(&self) -> Option<Material> {
         self.material
             .map(|m| Material::from_model(m, &self.options, None))
-    }
-
-    /// The free scale (1 for absolute data).
-    #[getter]
-    fn scale(&self) -> f64 {
-        self.report.scale
-    }
-
-    /// ½ Σ (weighted residual)² at the optimum.
-    #[getter]
-    fn cost(&self) -> f64 {
-        self.report.cost
-    }
-
-    /// RMS relative residual.
-    #[getter]
-    fn rms_rel(&self) -> f64 {
-        self.report.rms_rel
-    }
-
-    /// Samples fitted.
-    #[getter]
-    fn n_points(&self) -> usize {
-        self.report.n_points
-    }
-
-    /// Why the optimiser stopped.
-    #[getter]
-    fn termination(&self) -> String {
-        self.report.termination.label().to_string()
-    }
-
-    /// Did the optimiser converge?
-    #[getter]
-    fn converged(&self) -> bool {
-        self.report.termination.converged()
-    }
-
-    /// The warnings, as text.
-    #[getter]
-    fn warnings(&self) -> Vec<String> {
-        self.report.warnings.iter().map(|w| w.to_string()).collect()
     }
 
     /// The adequacy diagnostics (energy, peak, residual-kind check) as a
@@ -252,11 +232,11 @@ impl IncidenceFit {
             .collect();
         format!(
             "IncidenceFit(theta_in={}, {}, cost={:.6e}, rms_rel={:.4}, {})",
-            self.report.theta_in,
+            self.theta_in,
             params.join(", "),
-            self.report.cost,
-            self.report.rms_rel,
-            self.report.termination.label()
+            self.cost,
+            self.rms_rel,
+            self.termination
         )
     }
 }
@@ -435,13 +415,6 @@ impl Fit {
         klems: Option<String>,
         klems_colour: bool,
     ) -> PyResult<Vec<String>> {
-        if let Some(at) = at
-            && !(0.0..90.0).contains(&at)
-        {
-            return Err(errors::model(format!(
-                "at={at}: out of range; allowed: 0 ≤ θ_in < 90 degrees"
-            )));
-        }
         let klems_options = match klems.as_deref() {
             None => None,
             Some(basis) => {

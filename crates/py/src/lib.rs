@@ -6,7 +6,6 @@
 
 mod errors;
 mod fit;
-mod kernel;
 mod material;
 mod measurement;
 

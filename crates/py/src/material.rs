@@ -3,7 +3,6 @@
 //! `--source-omega`, `--curved`).
 
 use crate::errors;
-use crate::kernel;
 use brtf_model::{
     Bsdf, EvalOptions, FRESNEL_K_CLASSIC, Material as Model, MaterialKind, Variant, WordError,
 };
@@ -336,7 +335,7 @@ impl Material {
             let pi = flat(&np, phi_in, &incidence_shape)?;
             let (ti, pi) = (ti.as_slice()?[0], pi.as_slice()?[0]);
             brtf_model::check_incidence(ti, pi).map_err(|e| errors::model(e.to_string()))?;
-            py.detach(|| kernel::eval_degrees_one_incidence(&self.bsdf, ti, pi, to, po, &mut out));
+            py.detach(|| self.bsdf.eval_degrees_from(ti, pi, to, po, &mut out));
         } else {
             let ti = flat(&np, theta_in, &shape)?;
             let pi = flat(&np, phi_in, &shape)?;
@@ -344,7 +343,7 @@ impl Material {
             for (&t, &p) in ti.iter().zip(pi) {
                 brtf_model::check_incidence(t, p).map_err(|e| errors::model(e.to_string()))?;
             }
-            py.detach(|| kernel::eval_degrees(&self.bsdf, ti, pi, to, po, &mut out));
+            py.detach(|| self.bsdf.eval_degrees(ti, pi, to, po, &mut out));
         }
         let mut full_shape: Vec<usize> = shape.extract()?;
         full_shape.push(3);
@@ -431,11 +430,11 @@ impl Material {
         py.detach(|| {
             let start = std::time::Instant::now();
             if per_row {
-                kernel::eval_degrees(&self.bsdf, &ti, &pi, &theta_out, &phi_out, &mut out);
+                self.bsdf
+                    .eval_degrees(&ti, &pi, &theta_out, &phi_out, &mut out);
             } else {
-                kernel::eval_degrees_one_incidence(
-                    &self.bsdf, theta_in, phi_in, &theta_out, &phi_out, &mut out,
-                );
+                self.bsdf
+                    .eval_degrees_from(theta_in, phi_in, &theta_out, &phi_out, &mut out);
             }
             std::hint::black_box(&out);
             start.elapsed().as_secs_f64()

@@ -1,7 +1,9 @@
 //! `brtf.Measurement`, `brtf.read`, `brtf.read_klems`.
 
 use crate::errors;
+use crate::material::word;
 use brtf_gonio::Measurement as Scan;
+use brtf_gonio::klems::Sides;
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::prelude::*;
@@ -136,7 +138,7 @@ impl Measurement {
     #[getter]
     fn header<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let dict = PyDict::new(py);
-        for (key, value) in header_pairs(&self.scan.header) {
+        for (key, value) in self.scan.header_pairs() {
             dict.set_item(key, value)?;
         }
         Ok(dict)
@@ -165,38 +167,6 @@ impl Measurement {
     }
 }
 
-/// The header's key/value pairs (see [`Measurement::header`]).
-fn header_pairs(lines: &[String]) -> Vec<(String, String)> {
-    let mut pairs = Vec::new();
-    let mut label: Option<String> = None;
-    for line in lines {
-        let line = line.trim();
-        let Some(body) = line.strip_prefix('#') else {
-            // An `.mpc` value line: the value of the label before it.
-            if let Some(key) = label.take() {
-                pairs.push((key, line.to_string()));
-            }
-            continue;
-        };
-        label = None;
-        let body = body.trim();
-        if let Some(key) = body.strip_suffix(':') {
-            label = Some(key.trim().to_string());
-            continue;
-        }
-        let (key, value) = match body.find(|c: char| c.is_whitespace() || c == ':') {
-            Some(at) => (&body[..at], body[at + 1..].trim()),
-            None => (body, ""),
-        };
-        if key.is_empty() {
-            continue;
-        }
-        let value = value.trim_matches('"').replace('\t', " ");
-        pairs.push((key.to_string(), value));
-    }
-    pairs
-}
-
 /// Reads one measurement file (`.mpc` or pab-opto Mountain).
 #[pyfunction]
 pub(crate) fn read(py: Python<'_>, path: PathBuf) -> PyResult<Measurement> {
@@ -211,16 +181,7 @@ pub(crate) fn read(py: Python<'_>, path: PathBuf) -> PyResult<Measurement> {
 #[pyfunction]
 #[pyo3(signature = (path, side = "both"))]
 pub(crate) fn read_klems(py: Python<'_>, path: PathBuf, side: &str) -> PyResult<Vec<Measurement>> {
-    let keep = match side {
-        "both" => None,
-        "front" => Some(90.0),
-        "back" => Some(-90.0),
-        other => {
-            return Err(errors::model(format!(
-                "side={other:?}: expected \"front\", \"back\" or \"both\""
-            )));
-        }
-    };
+    let sides: Sides = word("side", side)?;
     let bsdf = py
         .detach(|| brtf_gonio::klems::read_path(&path))
         .map_err(errors::read)?;
@@ -229,10 +190,10 @@ pub(crate) fn read_klems(py: Python<'_>, path: PathBuf, side: &str) -> PyResult<
     Ok(scans
         .into_iter()
         // Light from the front has θ_in ≤ 90°, from the back θ_in > 90°.
-        .filter(|m| match keep {
-            None => true,
-            Some(limit) if limit > 0.0 => m.incidence.theta_deg <= 90.0,
-            Some(_) => m.incidence.theta_deg > 90.0,
+        .filter(|m| match sides {
+            Sides::Both => true,
+            Sides::Front => m.incidence.theta_deg <= 90.0,
+            Sides::Back => m.incidence.theta_deg > 90.0,
         })
         .map(|m| {
             let label = format!(

@@ -310,7 +310,6 @@ impl VirtualGonio {
             .collect();
         (values, total)
     }
-
 }
 
 /// `n` points in [0,1)², one in each of `n` distinct cells of the

@@ -50,7 +50,7 @@ mod scene_spec;
 mod shader;
 
 pub use camera::Camera;
-pub use check::{CheckOptions, CheckReport, check_fit};
+pub use check::{CheckError, CheckOptions, CheckReport, check_fit};
 pub use frame::Frame;
 pub use gonio::{
     Aperture, GonioError, GonioSetup, GonioValue, VirtualGonio, aperture_solid_angle, cone_average,

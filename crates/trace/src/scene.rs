@@ -85,7 +85,6 @@ impl Shape {
             Shape::Sphere { center, .. } => (p - center).normalize(),
         }
     }
-
 }
 
 #[inline]

@@ -31,6 +31,7 @@ pub fn export_into(
     result: &FitResult,
     options: &ExportOptions,
 ) -> Result<Amended, WorkflowError> {
+    options.validate()?;
     let update = FolderUpdate::amend(folder)?;
     let exported =
         write_exports(update.path(), result, options).map_err(|source| WorkflowError::Export {
@@ -137,4 +138,75 @@ pub fn plot_folder(
     relist(update.path(), &written.files, Producer::Plot)?;
     update.commit()?;
     Ok(written)
+}
+
+/// The Klems BSDF XML of the material `name` of the Radiance file `path`,
+/// written as `<out>/<name>.xml` (`out` defaults to the file's folder);
+/// with `with_cal` also `<name>-bsdf2klems.cal`, its BSDF as the function
+/// `bsdf2klems -f` takes.
+pub fn export_klems_of_material(
+    path: &Path,
+    name: Option<&str>,
+    eval: &brtf_model::EvalOptions,
+    mut options: KlemsOptions,
+    out: Option<&Path>,
+    with_cal: bool,
+) -> Result<Amended, WorkflowError> {
+    eval.validate()?;
+    let (name, material) = crate::read_material_file(path, name)?;
+    let bytes = std::fs::read(path).map_err(|source| brtf_io::IoError {
+        path: path.to_path_buf(),
+        what: "cannot read",
+        source,
+    })?;
+    options.name = name.clone();
+    let export = klems::klems_from_material(
+        &material,
+        eval,
+        &path.display().to_string(),
+        &brtf_io::sha256_hex(&bytes),
+        &options,
+    )?;
+    let out = out
+        .map(Path::to_path_buf)
+        .or_else(|| path.parent().map(Path::to_path_buf))
+        .unwrap_or_default();
+    brtf_io::ensure_folder(&out)?;
+    let xml = out.join(format!("{name}.xml"));
+    klems::write_klems(&xml, &export)?;
+    let mut files = vec![xml];
+    if with_cal {
+        let cal = brtf_radiance::export::klems_cal::bsdf_function_cal(&material)
+            .map_err(|e| WorkflowError::Usage(format!("--klems-cal: {e}")))?;
+        let cal_path = out.join(format!("{name}-bsdf2klems.cal"));
+        brtf_io::write_atomic(&cal_path, cal.as_bytes())?;
+        files.push(cal_path);
+    }
+    Ok(Amended {
+        files,
+        notes: export.notes,
+    })
+}
+
+/// `brtf check`: renders the fit folder `dir` through the virtual
+/// gonio-photometer ([`brtf_trace::check_fit`]) and writes the comparison
+/// as CSV to `out` (default `DIR/check.csv`). Returns the report and the
+/// file written.
+pub fn check_folder(
+    dir: &Path,
+    options: &brtf_trace::CheckOptions,
+    out: Option<&Path>,
+) -> Result<(brtf_trace::CheckReport, PathBuf), WorkflowError> {
+    options.validate()?;
+    let fit = read_fit(dir)?;
+    let report = brtf_trace::check_fit(&fit, dir, options)?;
+    let out = out.map_or_else(|| dir.join("check.csv"), Path::to_path_buf);
+    if let Some(folder) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
+        brtf_io::ensure_folder(folder)?;
+    }
+    let csv = report
+        .csv()
+        .map_err(|e| WorkflowError::Usage(format!("cannot format the check's CSV: {e}")))?;
+    brtf_io::write_atomic(&out, csv.as_bytes())?;
+    Ok((report, out))
 }

@@ -16,6 +16,24 @@ pub enum WorkflowError {
     /// A file or folder could not be read or written.
     #[error(transparent)]
     Io(#[from] brtf_io::IoError),
+    /// A Radiance file could not be read.
+    #[error(transparent)]
+    Rad(#[from] brtf_radiance::RadError),
+    /// A fit's material could not be made ready to render.
+    #[error(transparent)]
+    Shader(#[from] brtf_trace::ShaderError),
+    /// A virtual gonio-photometer setting is out of range.
+    #[error(transparent)]
+    Gonio(#[from] brtf_trace::GonioError),
+    /// The render check failed.
+    #[error(transparent)]
+    Check(#[from] brtf_trace::CheckError),
+    /// A picture's scene is not valid.
+    #[error(transparent)]
+    Scene(#[from] brtf_trace::SceneSpecError),
+    /// A measurement file could not be written.
+    #[error(transparent)]
+    WriteMeasurement(#[from] brtf_gonio::WriteError),
     /// A measurement file could not be read.
     #[error(transparent)]
     Read(#[from] brtf_gonio::ReadError),
@@ -36,6 +54,9 @@ pub enum WorkflowError {
     /// The Klems XML export could not be made.
     #[error(transparent)]
     Klems(#[from] brtf_radiance::export::klems::KlemsExportError),
+    /// Output could not be written (standard output, say).
+    #[error("cannot write: {0}")]
+    Write(#[from] std::io::Error),
     /// A step that failed, with what it was doing.
     #[error("{what}: {source}")]
     Context {

@@ -18,20 +18,31 @@
 //! A new output file is added here once and both front ends have it.
 
 mod amend;
+mod directions;
 mod en14501;
 mod error;
 mod folder;
+mod info;
 mod inputs;
+mod material;
+mod render;
 mod run;
 mod settings;
 
 pub use amend::{
-    Amended, ensure_fit_json, export_into, klems_of_fit_folder, plot_folder, read_fit,
-    write_klems_into,
+    Amended, check_folder, ensure_fit_json, export_into, export_klems_of_material,
+    klems_of_fit_folder, plot_folder, read_fit, write_klems_into,
 };
+pub use directions::parse_direction_line;
 pub use en14501::en14501_material;
 pub use error::WorkflowError;
 pub use folder::{FolderWritten, Outputs, save_fit, write_fit_folder};
+pub use info::describe_files;
 pub use inputs::{FitInputs, default_name, is_klems, sample_files};
+pub use material::{MaterialSource, RenderMaterial, load_render_material, read_material_file};
+pub use render::{
+    GonioRequest, GonioRun, ImageRequest, ImageRun, render_gonio, render_image, with_extension,
+    write_synth_set,
+};
 pub use run::{FitJob, FolderRequest, FolderRun, SampleOutcome, fit_samples, fit_to_folder};
 pub use settings::{FitSettings, MAX_PATCH_SAMPLES};

@@ -1,1 +1,3 @@
-//! Tests of brtf-workflow.
+//! Tests of brtf-workflow, one module per area.
+
+mod info;

@@ -12,45 +12,27 @@ use brtf_fit::Progress;
 use brtf_workflow::{FitInputs, FitJob, FolderRequest, FolderRun};
 use indicatif::{ProgressBar, ProgressStyle};
 
-/// The progress bar of the fits. With many samples, each sample's fit set
-/// adds its steps to the total when it begins them (`shared`).
-struct Bar {
-    bar: ProgressBar,
-    shared: bool,
-}
+/// The progress bar of the fits: each fit set (a sample, a side) adds its
+/// steps to the total when it begins them.
+struct Bar(ProgressBar);
 
 impl Bar {
-    fn new(shared: bool) -> Bar {
-        let style =
-            ProgressStyle::with_template("{spinner} fitting {msg}{pos}/{len} [{bar:30}] {elapsed}")
-                .expect("valid template")
-                .progress_chars("=> ");
-        Bar {
-            bar: ProgressBar::new(0).with_style(style),
-            shared,
-        }
+    fn new() -> Bar {
+        let template = "{spinner} fitting {msg}{pos}/{len} [{bar:30}] {elapsed}";
+        let style = ProgressStyle::with_template(template).expect("valid template");
+        Bar(ProgressBar::new(0).with_style(style.progress_chars("=> ")))
     }
 }
 
 impl Progress for Bar {
     fn begin(&self, total: u64) {
-        if self.shared {
-            self.bar.inc_length(total);
-        } else {
-            self.bar.set_length(total);
-            self.bar.set_position(0);
-        }
+        self.0.inc_length(total);
     }
     fn advance(&self) {
-        self.bar.inc(1);
-    }
-    fn end(&self) {
-        if !self.shared {
-            self.bar.finish_and_clear();
-        }
+        self.0.inc(1);
     }
     fn label(&self, text: &str) {
-        self.bar.set_message(format!("{text} "));
+        self.0.set_message(format!("{text} "));
     }
 }
 
@@ -74,7 +56,7 @@ pub(crate) fn run(args: FitArgs) -> Result<()> {
     };
     let inputs = FitInputs::classify(&args.files)?;
     if let FitInputs::Samples(folders) = &inputs {
-        let bar = Bar::new(true);
+        let bar = Bar::new();
         let outcomes = with_jobs(args.jobs, || {
             brtf_workflow::fit_samples(
                 folders,
@@ -85,7 +67,7 @@ pub(crate) fn run(args: FitArgs) -> Result<()> {
                 &bar,
             )
         })??;
-        bar.bar.finish_and_clear();
+        bar.0.finish_and_clear();
         let mut failed = 0;
         let mut printed = String::new();
         for (folder, outcome) in &outcomes {
@@ -107,10 +89,12 @@ pub(crate) fn run(args: FitArgs) -> Result<()> {
         return Ok(());
     }
     let job = FitJob::new(&inputs, &settings, args.name.clone(), command_line())?;
-    let bar = Bar::new(false);
+    let bar = Bar::new();
     let run = with_jobs(args.jobs, || {
         brtf_workflow::fit_to_folder(&job, settings.sides, &request, &bar)
-    })??;
+    });
+    bar.0.finish_and_clear();
+    let run = run??;
     report(&run, None);
     print(&run.text)
 }

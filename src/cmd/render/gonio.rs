@@ -2,13 +2,11 @@
 
 use super::SampleMaterial;
 use crate::cmd::shared::{csv_stdout, with_jobs, words, write_numbers};
-use anyhow::{Context, Result, bail};
-use brtf_gonio::{Channels, Measurement, SourceFormat};
-use brtf_trace::{
-    Aperture, GonioSetup, VirtualGonio, aperture_solid_angle, grid, measurement_from,
-};
+use anyhow::Result;
+use brtf_gonio::Channels;
+use brtf_trace::{Aperture, aperture_solid_angle};
+use brtf_workflow::{GonioRequest, render_gonio};
 use clap::Args;
-use glam::DVec3;
 use std::path::PathBuf;
 
 #[derive(Args, Debug)]
@@ -69,115 +67,53 @@ pub(crate) struct GonioArgs {
 }
 
 pub(crate) fn run(args: GonioArgs) -> Result<()> {
-    let loaded = args.sample.load()?;
-    let like: Option<Measurement> = match &args.like {
-        Some(p) => {
-            Some(brtf_gonio::read_path(p).with_context(|| format!("cannot read {}", p.display()))?)
-        }
-        None => None,
-    };
-    let theta_in = args
-        .theta_in
-        .or(like.as_ref().map(|m| m.incidence.theta_deg))
-        .context("give --theta-in (and --phi-in), or --like FILE")?;
-    let phi_in = args
-        .phi_in
-        .or(like.as_ref().map(|m| m.incidence.phi_deg))
-        .unwrap_or(0.0);
-    brtf_model::check_incidence(theta_in, phi_in)?;
-    if let Some(out) = &args.out {
-        let inputs = [&args.like, &args.sample.material];
-        let inputs: Vec<&std::path::Path> = inputs.iter().filter_map(|p| p.as_deref()).collect();
-        brtf_io::check_overwrite(out, &inputs, None, args.force)?;
-    }
-    let fit_omega = loaded.fit.as_ref().map(|f| f.options().source_omega);
-    let source_omega = aperture_solid_angle(Aperture::Source, args.source_omega, args.source_apex)?
-        .or(fit_omega)
-        .unwrap_or(0.0);
-    let detector_omega =
-        aperture_solid_angle(Aperture::Detector, args.detector_omega, args.detector_apex)?
-            .unwrap_or(0.0);
-    let setup = GonioSetup {
-        theta_in,
-        phi_in,
-        source_omega,
-        detector_omega,
-        samples: args.samples.max(1),
-        seed: args.seed,
-    };
-    setup.validate()?;
-    let directions: Vec<(f64, f64)> = match &like {
-        Some(m) => m.samples.iter().map(|s| (s.theta_deg, s.phi_deg)).collect(),
-        None => grid(
-            args.theta_step,
-            args.phi_step,
-            args.back || loaded.material.kind().is_transmitting(),
+    let request = GonioRequest {
+        like: args.like.clone(),
+        incidence: [args.theta_in, args.phi_in],
+        grid_steps: [args.theta_step, args.phi_step],
+        back: args.back,
+        source_omega: aperture_solid_angle(Aperture::Source, args.source_omega, args.source_apex)?,
+        detector_omega: aperture_solid_angle(
+            Aperture::Detector,
+            args.detector_omega,
+            args.detector_apex,
         )?,
+        samples: args.samples,
+        seed: args.seed,
+        channels: args.channels,
+        out: args.out.clone(),
+        force: args.force,
     };
-    let out_format = match &args.out {
-        Some(p) if p.extension().is_some_and(|e| e.eq_ignore_ascii_case("mpc")) => {
-            SourceFormat::Mpc
-        }
-        _ => SourceFormat::Mountain,
-    };
-    let mut channels = args
-        .channels
-        .unwrap_or_else(|| like.as_ref().map_or(Channels::Y, |m| m.channels));
-    if out_format == SourceFormat::Mpc && args.out.is_some() {
-        if args.channels == Some(Channels::Xyz) {
-            bail!(".mpc holds one channel; use --channels y or a Mountain file");
-        }
-        channels = Channels::Y;
-    }
-
-    let gonio = VirtualGonio::new(loaded.shader, setup);
-    let dirs: Vec<DVec3> = directions
-        .iter()
-        .map(|&(t, p)| brtf_model::direction(t, p))
-        .collect();
-    let start = std::time::Instant::now();
-    let (values, rays) = with_jobs(args.jobs, || gonio.render(&dirs))?;
-    let elapsed = start.elapsed().as_secs_f64();
+    let material = args.sample.load()?;
+    let file = args.sample.material.as_deref();
+    let run = with_jobs(args.jobs, || render_gonio(material, &request, file))??;
+    let secs = run.elapsed.as_secs_f64();
     say!(
         "brtf render gonio: {} directions × {} rays, {:.2} M rays in {:.2} s ({:.2} M rays/s)",
-        dirs.len(),
-        setup.samples,
-        rays.total() as f64 / 1e6,
-        elapsed,
-        rays.total() as f64 / 1e6 / elapsed.max(1e-9)
+        run.directions.len(),
+        args.samples.max(1),
+        run.rays.total() as f64 / 1e6,
+        secs,
+        run.rays.total() as f64 / 1e6 / secs.max(1e-9)
     );
-
-    let Some(path) = &args.out else {
-        let mut out = csv_stdout();
-        out.write_record([
-            "theta_out",
-            "phi_out",
-            "r",
-            "g",
-            "b",
-            "r_err",
-            "g_err",
-            "b_err",
-        ])?;
-        for (&(t, p), v) in directions.iter().zip(&values) {
-            let ([r, g, b], [er, eg, eb]) = (v.bsdf, v.std_err);
-            write_numbers(&mut out, &[t, p, r, g, b, er, eg, eb])?;
-        }
-        out.flush()?;
+    if args.out.is_some() {
         return Ok(());
-    };
-    let mut m = measurement_from(&setup, &directions, &values, channels, out_format);
-    if let Some(l) = &like {
-        for (s, src) in m.samples.iter_mut().zip(&l.samples) {
-            s.solid_angle_sr = src.solid_angle_sr;
-        }
-        m.sample_name = l.sample_name.clone();
     }
-    m.header.push(format!(
-        "# rendered by brtf render gonio: material {}, beam {} sr, detector {} sr, {} rays per direction, seed {}",
-        loaded.name, source_omega, detector_omega, setup.samples, setup.seed
-    ));
-    brtf_gonio::write_path(&m, path, out_format)
-        .with_context(|| format!("cannot write {}", path.display()))?;
+    let mut out = csv_stdout();
+    out.write_record([
+        "theta_out",
+        "phi_out",
+        "r",
+        "g",
+        "b",
+        "r_err",
+        "g_err",
+        "b_err",
+    ])?;
+    for (&(t, p), v) in run.directions.iter().zip(&run.values) {
+        let ([r, g, b], [er, eg, eb]) = (v.bsdf, v.std_err);
+        write_numbers(&mut out, &[t, p, r, g, b, er, eg, eb])?;
+    }
+    out.flush()?;
     Ok(())
 }

@@ -1,12 +1,10 @@
 //! `brtf render image`: the material on a sphere and a plane, as HDR + PNG.
 
 use super::SampleMaterial;
-use crate::cmd::output::write_atomic;
 use crate::cmd::shared::{with_jobs, words};
 use anyhow::Result;
-use brtf_trace::MATERIAL_NAME;
-use brtf_trace::{LightKind, LightSpec, SceneKind, SceneSpec, Settings, ViewSpec, hdr};
-use brtf_trace::{auto_exposure, write_png};
+use brtf_trace::{LightKind, LightSpec, SceneKind, SceneSpec, Settings, ViewSpec};
+use brtf_workflow::{ImageRequest, render_image};
 use clap::Args;
 use std::path::PathBuf;
 
@@ -134,97 +132,36 @@ impl ImageArgs {
             direct_only: self.direct_only,
         }
     }
-
-    /// `PREFIX` + `ext`. A prefix given with one of the outputs'
-    /// extensions (`--out img.hdr`) loses it, so it does not write
-    /// `img.hdr.hdr`.
-    fn with_ext(&self, ext: &str) -> PathBuf {
-        let prefix = match self.out.extension().and_then(|e| e.to_str()) {
-            Some("hdr" | "png") => self.out.with_extension(""),
-            _ => self.out.clone(),
-        };
-        let mut p = prefix.into_os_string();
-        p.push(ext);
-        PathBuf::from(p)
-    }
 }
 
 pub(crate) fn run(args: ImageArgs) -> Result<()> {
     let spec = args.spec();
-    spec.validate()?;
-    let samples = f64::from(args.samples);
-    let check = brtf_model::OptionError::check;
-    check(
-        "--samples",
-        samples,
-        (1.0..=65536.0).contains(&samples),
-        "1 to 65536",
-    )?;
-    if let Some(e) = args.exposure {
-        check(
-            "--exposure",
-            e,
-            e.is_finite() && e > 0.0,
-            "a number above 0",
-        )?;
-    }
-    for ext in [".hdr", ".png", ".rad", ".vf"] {
-        let inputs: Vec<&std::path::Path> =
-            args.sample.material.iter().map(|m| m.as_path()).collect();
-        brtf_io::check_overwrite(&args.with_ext(ext), &inputs, None, false)?;
-    }
-    let loaded = args.sample.load()?;
-    let is_table = loaded.shader.is_table();
-    let (scene, camera) = spec.build(loaded.shader)?;
-    let options = spec.image_options(args.samples, !args.no_jitter, args.seed);
-    let rendered = with_jobs(args.jobs, || brtf_trace::render(&scene, &camera, &options))?;
-    let secs = rendered.elapsed.as_secs_f64();
+    let request = ImageRequest {
+        samples: args.samples,
+        jitter: !args.no_jitter,
+        seed: args.seed,
+        exposure: args.exposure,
+        radiance: args.radiance,
+    };
+    let material = args.sample.load()?;
+    let file = args.sample.material.as_deref();
+    let run = with_jobs(args.jobs, || {
+        render_image(material, &spec, &request, &args.out, file)
+    })??;
+    let secs = run.elapsed.as_secs_f64();
+    let rays = run.rays.total() as f64 / 1e6;
     say!(
-        "brtf render image: {}×{} × {} samples, {:.2} M rays ({} camera, {} shadow, {} secondary) in {:.2} s ({:.2} M rays/s)",
-        args.width,
-        args.height,
-        options.samples,
-        rendered.rays.total() as f64 / 1e6,
-        rendered.rays.primary,
-        rendered.rays.shadow,
-        rendered.rays.secondary,
-        secs,
-        rendered.rays.total() as f64 / 1e6 / secs.max(1e-9)
+        "brtf render image: {}×{} × {} samples, {rays:.2} M rays ({} camera, {} shadow, {} secondary) in {secs:.2} s ({:.2} M rays/s)",
+        run.size[0],
+        run.size[1],
+        run.samples,
+        run.rays.primary,
+        run.rays.shadow,
+        run.rays.secondary,
+        rays / secs.max(1e-9)
     );
-
-    let view = camera.view_options();
-    let mut hdr_bytes = Vec::new();
-    hdr::write(
-        &mut hdr_bytes,
-        &rendered.picture,
-        &[
-            format!("SOFTWARE= brtf {} (brtf-trace)", env!("CARGO_PKG_VERSION")),
-            format!("VIEW= {}", view.trim_start_matches("rview ")),
-        ],
-    )?;
-    write_atomic(&args.with_ext(".hdr"), &hdr_bytes)?;
-    let exposure = args
-        .exposure
-        .unwrap_or_else(|| auto_exposure(&rendered.picture));
-    let mut png_bytes = Vec::new();
-    write_png(&mut png_bytes, &rendered.picture, exposure)?;
-    write_atomic(&args.with_ext(".png"), &png_bytes)?;
-    if args.radiance {
-        let prim = brtf_radiance::primitive_from_material(&loaded.material, MATERIAL_NAME);
-        let name = args
-            .out
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        let rad = spec.radiance_text(&brtf_radiance::format_primitive(&prim), &name);
-        write_atomic(&args.with_ext(".rad"), rad.as_bytes())?;
-        write_atomic(&args.with_ext(".vf"), format!("{view}\n").as_bytes())?;
-        if is_table {
-            say!(
-                "brtf render image: note: {}.rad holds the fit's static material; brtf-trace rendered its θ_in table",
-                args.out.display()
-            );
-        }
+    for note in &run.notes {
+        say!("brtf render image: note: {note}");
     }
     Ok(())
 }

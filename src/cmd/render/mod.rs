@@ -1,27 +1,14 @@
-//! `brtf render gonio|image`: brtf's own ray tracer (brtf-trace).
-//!
-//! * `gonio` ([`gonio`]): the virtual gonio-photometer. It reproduces a
-//!   measurement's geometry (`--like FILE`) or a θ/φ grid, renders the
-//!   BSDF per sample and writes it as a measurement file (`.mpc` or
-//!   Mountain) or CSV.
-//! * `image` ([`image`]): the material on a sphere and a plane under a
-//!   source, as a Radiance HDR picture and a tone-mapped PNG; `--radiance`
-//!   also writes the same scene and view for `rpict`.
-//!
-//! The material comes from a Radiance file (`--material`) or a fit folder
-//! (`--fit DIR`: its θ_in-interpolated table, or `--static` for one set).
-//! The scenes, grids and checks live in brtf-trace; this module maps the
-//! options onto them, reports progress and writes the files.
+//! `brtf render gonio|image`: brtf's own ray tracer through
+//! [`brtf_workflow::render_gonio`] and [`brtf_workflow::render_image`], on
+//! a material from a Radiance file (`--material`) or a fit folder (`--fit`).
 
 pub(crate) mod gonio;
 pub(crate) mod image;
 
-use super::material::{FormulaArgs, MaterialArgs};
 use super::shared::words;
-use anyhow::{Context, Result};
-use brtf_fit::FitResult;
-use brtf_model::{FRESNEL_K_CLASSIC, Material, Variant, parse_fresnel_k};
-use brtf_trace::Shader;
+use anyhow::Result;
+use brtf_model::{Variant, parse_fresnel_k};
+use brtf_workflow::{MaterialSource, RenderMaterial, load_render_material};
 use clap::{Args, Subcommand};
 use gonio::GonioArgs;
 use image::ImageArgs;
@@ -77,62 +64,20 @@ pub(crate) struct SampleMaterial {
     pub fresnel_k: Option<f64>,
 }
 
-/// A loaded material: the shader and a one-set material for exports.
-pub(crate) struct Loaded {
-    pub shader: Shader,
-    /// The static material (the fit's all-incidence set, or the file's).
-    pub material: Material,
-    pub name: String,
-    /// The fit, when the material came from one.
-    pub fit: Option<FitResult>,
-}
-
 impl SampleMaterial {
-    pub(crate) fn load(&self) -> Result<Loaded> {
-        if let Some(dir) = &self.fit {
-            let fit = brtf_workflow::read_fit(dir)?;
-            let mut options = fit.options();
-            if let Some(v) = self.variant {
-                options.variant = v;
-            }
-            if let Some(k) = self.fresnel_k {
-                options.fresnel_k = k;
-            }
-            let material = fit
-                .static_material()
-                .context("the fit holds no valid material")?;
-            let shader = match (&fit.table, self.static_material) {
-                (Some(table), false) => Shader::from_table(table, &options)?,
-                _ => Shader::new(&material, &options),
-            };
-            return Ok(Loaded {
-                shader,
-                material,
-                name: fit.name.clone(),
-                fit: Some(fit),
-            });
-        }
-        let file = self
-            .material
-            .clone()
-            .expect("clap requires --material or --fit");
-        let args = MaterialArgs {
-            material: file,
-            name: self.name.clone(),
-            formula: FormulaArgs {
-                variant: self.variant.unwrap_or_default(),
-                fresnel_k: self.fresnel_k.unwrap_or(FRESNEL_K_CLASSIC),
+    /// The material, ready to render.
+    pub(crate) fn load(&self) -> anyhow::Result<RenderMaterial> {
+        let source = match (&self.fit, &self.material) {
+            (Some(dir), _) => MaterialSource::Fit {
+                dir: dir.clone(),
+                fixed: self.static_material,
             },
-            source_omega: 0.0,
-            curved: false,
+            (None, Some(path)) => MaterialSource::File {
+                path: path.clone(),
+                name: self.name.clone(),
+            },
+            (None, None) => anyhow::bail!("give --material M.rad or --fit DIR"),
         };
-        let (name, material) = args.load()?;
-        let options = args.options()?;
-        Ok(Loaded {
-            shader: Shader::new(&material, &options),
-            material,
-            name,
-            fit: None,
-        })
+        Ok(load_render_material(&source, self.variant, self.fresnel_k)?)
     }
 }

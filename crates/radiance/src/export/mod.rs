@@ -41,6 +41,21 @@ pub struct ExportOptions {
     pub preview: bool,
 }
 
+impl ExportOptions {
+    /// Checks `at`: 0 ≤ θ_in < 90 degrees.
+    pub fn validate(&self) -> Result<(), brtf_model::OptionError> {
+        match self.at {
+            Some(at) => brtf_model::OptionError::check(
+                "--at",
+                at,
+                (0.0..90.0).contains(&at),
+                "0 ≤ θ_in < 90 degrees",
+            ),
+            None => Ok(()),
+        }
+    }
+}
+
 impl Default for ExportOptions {
     fn default() -> Self {
         ExportOptions {
