@@ -115,21 +115,35 @@ impl Block<'_> {
                 .for_each(fill);
         }
         self.factors = factors;
-        self.log_values = if kind == ResidualKind::Log {
-            let log = |s: &FitSample| -> Vec<f64> {
-                s.value[..channels]
-                    .iter()
-                    .map(|&y| (y.max(0.0) + floor).ln())
-                    .collect()
+        // The data's side of every log residual, written in place (one
+        // value per sample and channel; no allocation per sample).
+        let mut log_values = std::mem::take(&mut self.log_values);
+        if kind == ResidualKind::Log {
+            log_values.resize(self.samples.len() * channels, 0.0);
+            let samples = &self.samples;
+            let fill = |(piece, out): (usize, &mut [f64])| {
+                let first = piece * FACTOR_PIECE;
+                for (s, out) in samples[first..].iter().zip(out.chunks_exact_mut(channels)) {
+                    for (o, &y) in out.iter_mut().zip(&s.value[..channels]) {
+                        *o = (y.max(0.0) + floor).ln();
+                    }
+                }
             };
             if self.samples.len() >= PARALLEL_ROWS {
-                self.samples.par_iter().flat_map_iter(log).collect()
+                log_values
+                    .par_chunks_mut(FACTOR_PIECE * channels)
+                    .enumerate()
+                    .for_each(fill);
             } else {
-                self.samples.iter().flat_map(log).collect()
+                log_values
+                    .chunks_mut(FACTOR_PIECE * channels)
+                    .enumerate()
+                    .for_each(fill);
             }
         } else {
-            Vec::new()
-        };
+            log_values.clear();
+        }
+        self.log_values = log_values;
     }
 
     /// The data's log of value `row` (see `log_values`), or NaN for
