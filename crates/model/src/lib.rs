@@ -34,6 +34,7 @@ mod batch;
 mod batch_gradient;
 mod bsdf;
 mod colour;
+mod composite;
 mod degrees;
 mod kind;
 mod material;
@@ -47,6 +48,10 @@ pub use batch_gradient::{GeometryBatch, PairTerms};
 pub use bsdf::{Bsdf, Geometry, Gradient, Rgb, ViewSplit};
 pub use colour::{
     PRIMARIES_XY, WHITE_XY, luminance, rgb_to_xyz, rgb_to_xyz_matrix, xyz_to_rgb, xyz_to_rgb_matrix,
+};
+pub use composite::{
+    Composite, CompositeBsdf, MAX_LOBES, MAX_SHAPE_ARGS, Shape, ShapeArg, composite_albedo,
+    lobe_splits, lobe_weights, orientation_of_angle,
 };
 pub use degrees::{cos_degrees, sin_cos_degrees};
 pub use kind::{MaterialKind, Variant};

@@ -33,6 +33,8 @@ pub enum ModelError {
     RoughnessTooSmall,
     /// The orientation vector is zero or not finite.
     BadOrientation,
+    /// A lobe sum's split (mixing coefficient) is outside [0, 1].
+    BadSplit,
 }
 
 impl fmt::Display for ModelError {
@@ -52,6 +54,7 @@ impl fmt::Display for ModelError {
             ModelError::BadOrientation => {
                 f.write_str("orientation vector must be finite and non-zero")
             }
+            ModelError::BadSplit => f.write_str("a lobe split must be in [0, 1]"),
         }
     }
 }
