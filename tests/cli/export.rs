@@ -61,6 +61,7 @@ fn report(kind: MaterialKind, theta_in: f64, args: &[f64]) -> FitReport {
         gates: Vec::new(),
         weighting: brtf_fit::Weighting::Caller,
         rms_rel: 0.012,
+        e1: None,
         cost: 0.5,
         floor: 0.0,
         termination: Termination::Converged {
@@ -137,10 +138,10 @@ fn result_of(
 ) -> FitResult {
     // Rings of azimuths share a θ_in: their rows are averaged over φ_in.
     let table = (incidences.len() > 1).then(|| {
-        ParamTable::from_reports(config.kind, config.orientation, &incidences, method)
+        ParamTable::from_reports(config.shape(), config.orientation, &incidences, method)
             .or_else(|_| {
                 ParamTable::from_reports_phi_averaged(
-                    config.kind,
+                    config.shape(),
                     config.orientation,
                     &incidences,
                     method,
@@ -849,7 +850,7 @@ fn azimuth_export_matches_live_rtrace() {
         let mut result = result_of(name, config, reports.clone(), None, method);
         result.table = Some(
             ParamTable::from_reports_over_azimuth(
-                MaterialKind::Trans2,
+                brtf_model::Shape::single(MaterialKind::Trans2),
                 orientation,
                 &reports,
                 method,
@@ -1057,5 +1058,6 @@ fn synthetic(material: &Material, theta_in: f64) -> IncidenceData {
         gates: Vec::new(),
         weighting: brtf_fit::Weighting::Caller,
         patch_pairs: None,
+        cosine_weighted: false,
     }
 }

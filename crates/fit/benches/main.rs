@@ -57,6 +57,7 @@ pub fn bench_data() -> (Material, IncidenceData) {
         gates: Vec::new(),
         weighting: brtf_fit::Weighting::Caller,
         patch_pairs: None,
+        cosine_weighted: false,
     };
     (truth, data)
 }

@@ -2,7 +2,7 @@
 //! not run ([`FitError`]).
 
 use crate::problem::ResidualKind;
-use brtf_model::{EvalOptions, MaterialKind};
+use brtf_model::{EvalOptions, MaterialKind, Shape};
 use serde::{Deserialize, Serialize};
 
 /// Robust loss, applied by iteratively reweighting the residuals.
@@ -99,10 +99,21 @@ pub struct FitConfig {
     /// one patch, so patch averages cannot tell its width.
     #[serde(default = "default_min_roughness")]
     pub min_roughness: f64,
+    /// Specular lobes over the one diffuse base (1: the plain type).
+    #[serde(default = "one_lobe")]
+    pub lobes: usize,
+    /// The in-plane orientation of an anisotropic type is fitted
+    /// (`orient`), not fixed by `orientation`.
+    #[serde(default)]
+    pub oriented: bool,
 }
 
 fn default_min_roughness() -> f64 {
     crate::MIN_ROUGHNESS
+}
+
+fn one_lobe() -> usize {
+    1
 }
 
 impl FitConfig {
@@ -119,6 +130,18 @@ impl FitConfig {
             loss: RobustLoss::None,
             multistart: true,
             min_roughness: crate::MIN_ROUGHNESS,
+            lobes: 1,
+            oriented: false,
+        }
+    }
+
+    /// The shape fitted: the type, its lobes and whether the orientation
+    /// is an argument.
+    pub fn shape(&self) -> Shape {
+        Shape {
+            kind: self.kind,
+            lobes: self.lobes,
+            oriented: self.oriented,
         }
     }
 }

@@ -76,6 +76,10 @@ pub struct IncidenceData {
     /// averaged over for each sample. `None`: the model is evaluated at
     /// each sample's own direction.
     pub patch_pairs: Option<Arc<PatchPairs>>,
+    /// The file's values are the BSDF times |cos θ_out| (a DSF or raw
+    /// signal): E1 weighs the samples' misfits by it, to compare in the
+    /// file's own quantity.
+    pub cosine_weighted: bool,
 }
 
 /// The (light, view) pairs over which the model is averaged for each

@@ -23,21 +23,22 @@ use crate::data::IncidenceData;
 use crate::recipe::PreparedMeasurement;
 use crate::report::FitReport;
 use brtf_gonio::Hemisphere;
-use brtf_model::{Bsdf, Directions, Material, RgbBatch};
+use brtf_model::{Composite, CompositeBsdf, Directions, RgbBatch, composite_albedo};
 use glam::DVec3;
 use rayon::prelude::*;
 
 /// The brightest fraction of the fitted samples whose centroid is the peak.
 const PEAK_FRACTION: f64 = 0.002;
 
-/// The material of `report` with `config`'s orientation.
-fn material(config: &FitConfig, report: &FitReport) -> Option<Material> {
-    Material::new(
-        config.kind,
+/// The material of `report` with `config`'s orientation, ready to evaluate.
+pub(crate) fn fitted_bsdf(config: &FitConfig, report: &FitReport) -> Option<CompositeBsdf> {
+    let material = Composite::new(
+        config.shape(),
         &report.material_args,
         Some(DVec3::from_array(config.orientation)),
     )
-    .ok()
+    .ok()?;
+    Some(CompositeBsdf::new(&material, &config.options))
 }
 
 /// Luminance of the used channels of `values` (grey: the value itself).
@@ -61,7 +62,7 @@ pub(crate) struct Measured {
 pub(crate) fn measured_integrals(
     prepared: &PreparedMeasurement,
     data: &IncidenceData,
-    bsdf: &Bsdf,
+    bsdf: &CompositeBsdf,
     scale: f64,
 ) -> Measured {
     measured_sums(prepared, data, &fitted_model(prepared, data, bsdf), scale)
@@ -71,9 +72,15 @@ pub(crate) fn measured_integrals(
 /// in the order of [`PreparedMeasurement::fitted`], at the directions of
 /// the fitter's view of them (`data`), or averaged over their patch pairs.
 /// Evaluated in parallel; the sums over them stay in sample order.
-fn fitted_model(prepared: &PreparedMeasurement, data: &IncidenceData, bsdf: &Bsdf) -> Vec<f64> {
+fn fitted_model(
+    prepared: &PreparedMeasurement,
+    data: &IncidenceData,
+    bsdf: &CompositeBsdf,
+) -> Vec<f64> {
     let channels = prepared.channels();
     if prepared.patch_pairs.is_some() {
+        // Patch-averaged fits take one primitive.
+        let bsdf = &bsdf.parts()[0].1;
         let indices: Vec<usize> = prepared.fitted().map(|(i, _)| i).collect();
         return indices
             .par_iter()
@@ -132,9 +139,9 @@ fn measured_sums(
 }
 
 /// The model's ρ_dh and τ_dh at the incidence of `prepared`, in luminance.
-pub(crate) fn model_albedo(prepared: &PreparedMeasurement, bsdf: &Bsdf) -> (f64, f64) {
+pub(crate) fn model_albedo(prepared: &PreparedMeasurement, bsdf: &CompositeBsdf) -> (f64, f64) {
     let channels = prepared.channels();
-    let a = brtf_model::albedo(bsdf, prepared.measurement.incident_direction(), 1e-6);
+    let a = composite_albedo(bsdf, prepared.measurement.incident_direction(), 1e-6);
     let total =
         |x: [f64; 3], spike: [f64; 3]| luminance([0, 1, 2].map(|c| x[c] + spike[c]), channels);
     (total(a.rho, a.rho_spike), total(a.tau, a.tau_spike))
@@ -149,8 +156,7 @@ pub(crate) fn diagnose(
     report: &FitReport,
     config: &FitConfig,
 ) -> Option<Adequacy> {
-    let material = material(config, report)?;
-    let bsdf = Bsdf::new(&material, &config.options);
+    let bsdf = fitted_bsdf(config, report)?;
     let scale = report.scale;
     let ((rho_model, tau_model), model) = rayon::join(
         || model_albedo(prepared, &bsdf),

@@ -15,7 +15,9 @@ use crate::report::{
 use crate::robust;
 use crate::solve::{Solved, Solver, Stage};
 use crate::uncertainty::standard_errors;
-use brtf_model::{Bsdf, Geometry, GeometryBatch, Material};
+use brtf_model::{
+    Bsdf, Geometry, GeometryBatch, Material, Shape, ShapeArg, lobe_splits, lobe_weights,
+};
 use glam::DVec3;
 use nalgebra::DVector;
 use rayon::prelude::*;
@@ -77,6 +79,10 @@ pub(crate) fn shared_geometry(
     data: &[IncidenceData],
     config: &FitConfig,
 ) -> Result<Vec<SharedGeometry>, FitError> {
+    // A fitted orientation turns the tangent frame: no geometry to keep.
+    if config.oriented {
+        return Ok(data.iter().map(|_| SharedGeometry::Recomputed).collect());
+    }
     let bsdf = geometry_bsdf(config)?;
     let total_pairs: usize = data
         .iter()
@@ -129,8 +135,28 @@ fn fit_many(
         return Err(FitError::MixedChannels);
     }
     let gray = config.gray || channels == 1;
-    let map = ParamMap::new(config.kind, gray, config.free_scale)
-        .with_min_roughness(config.min_roughness);
+    let shape = config.shape();
+    if !shape.is_single() && data.iter().any(|d| d.patch_pairs.is_some()) {
+        return Err(FitError::Failed {
+            origin: label.into(),
+            reason: "lobe sums and a fitted orientation need gonio-photometer scans: patch \
+                     averages are fitted with one primitive of fixed orientation"
+                .into(),
+        });
+    }
+    let map =
+        ParamMap::new(shape, gray, config.free_scale).with_min_roughness(config.min_roughness);
+    // A lobe sum starts from the one-lobe fit (and its split variations):
+    // it can then only end at a cost at or below it.
+    let base = if shape.lobes > 1 {
+        let one = FitConfig {
+            lobes: 1,
+            ..config.clone()
+        };
+        Some(fit_many(data, &one, label, geometry)?)
+    } else {
+        None
+    };
     // The blocks' geometry once per fit, or the fit set's shared one.
     let own_geometry = match geometry {
         Some(_) => None,
@@ -170,7 +196,17 @@ fn fit_many(
         || {
             rayon::join(
                 || config.floor.unwrap_or_else(|| prepare::auto_floor(&stats)),
-                || prepare::starting_points(&stats, &map, config, channels),
+                || match &base {
+                    Some(base) => lobe_starts(base, &map, config),
+                    None => {
+                        let starts = prepare::starting_points(&stats, &map, config, channels);
+                        if shape.oriented {
+                            with_orientations(starts, &map)
+                        } else {
+                            starts
+                        }
+                    }
+                },
             )
         },
         // Subsamples are taken only by the multi-start and the polish.
@@ -275,12 +311,40 @@ fn fit_many(
     let u_start = ends.swap_remove(0);
     // Over many incidences Gauss-Newton can converge linearly (a model
     // that cannot follow every incidence): extrapolated rounds there.
-    let mut solved = if data.len() > 1 {
-        solver.solve_final(&blocks, u_start)
-    } else {
-        solver.solve(&blocks, u_start, Stage::FINAL)
+    let final_solve = |u: DVector<f64>| {
+        if data.len() > 1 {
+            solver.solve_final(&blocks, u)
+        } else {
+            solver.solve(&blocks, u, Stage::FINAL)
+        }
     };
+    let mut solved = final_solve(u_start);
     evaluations += solved.evaluations;
+    // A lobe sum is never worse than its one-lobe fit, from which it can
+    // restart exactly (every lobe at the one lobe's roughness).
+    if let Some(base) = &base
+        && matches!(
+            solved.cost.partial_cmp(&base.cost),
+            Some(std::cmp::Ordering::Greater) | None
+        )
+    {
+        let (_, u) = &lobe_starts(base, &map, config)[0];
+        solved = final_solve(u.clone());
+        evaluations += solved.evaluations;
+    }
+    // One point per material: lobes by roughness, the orientation in
+    // [0°, 180°) with the first lobe rougher along u than along v. The
+    // turn changes nothing but the numbers; the final solve there gives
+    // the report's standard errors in them.
+    if solved.cost.is_finite()
+        && let Some(u) = canonical(&map, &solved.u)
+    {
+        let again = final_solve(u);
+        evaluations += again.evaluations;
+        if again.cost <= solved.cost * (1.0 + 1e-9) {
+            solved = again;
+        }
+    }
     if !solved.cost.is_finite() {
         return Err(FitError::Failed {
             origin: label.into(),
@@ -431,6 +495,219 @@ fn same_basin(a: &Solved, b: &Solved) -> bool {
             .all(|(x, y)| (x - y).abs() <= 1e-2)
 }
 
+/// The unconstrained point of physical flat arguments `args` and `scale`.
+fn unconstrained(map: &ParamMap, args: &[f64], scale: f64) -> DVector<f64> {
+    DVector::from_iterator(
+        map.len(),
+        map.slots.iter().enumerate().map(|(i, slot)| {
+            let p = match slot.target {
+                Target::Arg(a) => args[a],
+                Target::Gray => args[0],
+                Target::Scale => scale,
+            };
+            map.to_unconstrained(i, p)
+        }),
+    )
+}
+
+/// Roughness factors (first lobe, last lobe) and splits of the lobe-sum
+/// starts besides the one-lobe fit itself.
+const LOBE_SPREADS: [(f64, f64, f64); 6] = [
+    (0.5, 2.0, 0.3),
+    (0.5, 2.0, 0.6),
+    (0.3, 1.5, 0.3),
+    (0.3, 1.5, 0.6),
+    (0.6, 3.0, 0.3),
+    (0.6, 3.0, 0.6),
+];
+
+/// The starts of a lobe sum, from its one-lobe fit `base`: first the
+/// one-lobe material itself (every lobe at its roughness: the same `f`),
+/// then lobes spread narrower and wider around it with different splits.
+fn lobe_starts(
+    base: &FitReport,
+    map: &ParamMap,
+    config: &FitConfig,
+) -> Vec<([f64; 2], DVector<f64>)> {
+    let shape = map.shape;
+    let one = Shape { lobes: 1, ..shape };
+    let one_args = &base.material_args;
+    let at = |a: ShapeArg| one_args[one.index_of(a).expect("a one-lobe argument")];
+    let rough = [
+        at(ShapeArg::RoughU(0)),
+        if shape.kind.is_anisotropic() {
+            at(ShapeArg::RoughV(0))
+        } else {
+            at(ShapeArg::RoughU(0))
+        },
+    ];
+    let lowest = config.min_roughness.max(crate::MIN_ROUGHNESS);
+    let clamp = |r: f64| r.clamp(lowest, crate::MAX_ROUGHNESS);
+    let n = shape.lobes;
+    let start = |factors: &[f64], weights: &[f64]| -> ([f64; 2], DVector<f64>) {
+        let mut args = vec![0.0; shape.n_args()];
+        args[..4].copy_from_slice(&one_args[..4]);
+        for (j, s) in lobe_splits(weights).into_iter().enumerate() {
+            args[shape.index_of(ShapeArg::Split(j)).expect("split")] = s;
+        }
+        for (k, f) in factors.iter().enumerate() {
+            args[shape.index_of(ShapeArg::RoughU(k)).expect("rough")] = clamp(rough[0] * f);
+            if let Some(v) = shape.index_of(ShapeArg::RoughV(k)) {
+                args[v] = clamp(rough[1] * f);
+            }
+        }
+        if let Some(o) = shape.index_of(ShapeArg::Orient) {
+            args[o] = at(ShapeArg::Orient);
+        }
+        let first = [clamp(rough[0] * factors[0]), clamp(rough[1] * factors[0])];
+        (first, unconstrained(map, &args, base.scale))
+    };
+    let even = vec![1.0 / n as f64; n];
+    let mut starts = vec![start(&vec![1.0; n], &even)];
+    for &(low, high, first) in &LOBE_SPREADS {
+        // Factors from `low` to `high`, geometric; the first lobe's share
+        // `first`, the rest evenly.
+        let factors: Vec<f64> = (0..n)
+            .map(|k| low * (high / low).powf(k as f64 / (n - 1) as f64))
+            .collect();
+        let mut weights = vec![(1.0 - first) / (n - 1) as f64; n];
+        weights[0] = first;
+        starts.push(start(&factors, &weights));
+    }
+    starts
+}
+
+/// Orientations of the starts of a fitted orientation, degrees.
+const START_ORIENTATIONS: [f64; 4] = [0.0, 45.0, 90.0, 135.0];
+
+/// The starts of an anisotropic type with its orientation fitted: each
+/// start rougher along u than along v at every orientation of
+/// [`START_ORIENTATIONS`] (rougher along v is the same at 90° more), an
+/// isotropic start at 0° only.
+fn with_orientations(
+    starts: Vec<([f64; 2], DVector<f64>)>,
+    map: &ParamMap,
+) -> Vec<([f64; 2], DVector<f64>)> {
+    let Some(slot) = map.slot_of_arg(map.shape.index_of(ShapeArg::Orient).expect("orient")) else {
+        return starts;
+    };
+    let mut turned = Vec::new();
+    for (rough, u) in starts {
+        if rough[0] < rough[1] {
+            continue;
+        }
+        let angles: &[f64] = if rough[0] > rough[1] {
+            &START_ORIENTATIONS
+        } else {
+            &START_ORIENTATIONS[..1]
+        };
+        for &angle in angles {
+            let mut u = u.clone();
+            u[slot] = map.to_unconstrained(slot, angle);
+            turned.push((rough, u));
+        }
+    }
+    turned
+}
+
+/// The canonical point of the material at `u`, when it is another point:
+/// lobes ordered by roughness (geometric mean of u and v), and a fitted
+/// orientation in [0°, 180°) with the first lobe rougher along u than
+/// along v (the same material at 90° more, u and v swapped).
+fn canonical(map: &ParamMap, u: &DVector<f64>) -> Option<DVector<f64>> {
+    let shape = map.shape;
+    if shape.is_single() {
+        return None;
+    }
+    let p: Vec<f64> = (0..map.len()).map(|i| map.to_physical(i, u[i]).0).collect();
+    let (mut args, scale) = map.material_args(&p);
+    let index = |a: ShapeArg| shape.index_of(a).expect("the shape's argument");
+    let lobe = |args: &[f64], k: usize| -> (f64, Option<f64>) {
+        (
+            args[index(ShapeArg::RoughU(k))],
+            shape.index_of(ShapeArg::RoughV(k)).map(|i| args[i]),
+        )
+    };
+    let splits: Vec<f64> = (0..shape.lobes - 1)
+        .map(|j| args[index(ShapeArg::Split(j))])
+        .collect();
+    let weights = lobe_weights(&splits);
+    let mut order: Vec<usize> = (0..shape.lobes).collect();
+    let size = |k: usize| {
+        let (ru, rv) = lobe(&args, k);
+        (ru * rv.unwrap_or(ru)).sqrt()
+    };
+    order.sort_by(|&a, &b| size(a).total_cmp(&size(b)));
+    let old = args.clone();
+    for (to, &from) in order.iter().enumerate() {
+        let (ru, rv) = lobe(&old, from);
+        args[index(ShapeArg::RoughU(to))] = ru;
+        if let (Some(v), Some(i)) = (rv, shape.index_of(ShapeArg::RoughV(to))) {
+            args[i] = v;
+        }
+    }
+    let sorted: Vec<f64> = order.iter().map(|&k| weights[k]).collect();
+    for (j, s) in lobe_splits(&sorted).into_iter().enumerate() {
+        args[index(ShapeArg::Split(j))] = s;
+    }
+    if let Some(o) = shape.index_of(ShapeArg::Orient) {
+        let (ru, rv) = lobe(&args, 0);
+        if rv.is_some_and(|rv| ru < rv) {
+            for k in 0..shape.lobes {
+                let (iu, iv) = (index(ShapeArg::RoughU(k)), index(ShapeArg::RoughV(k)));
+                args.swap(iu, iv);
+            }
+            args[o] += 90.0;
+        }
+        args[o] = args[o].rem_euclid(180.0);
+    }
+    let moved = args
+        .iter()
+        .zip(&old)
+        .any(|(a, b)| (a - b).abs() > 1e-12 * a.abs().max(1.0));
+    moved.then(|| unconstrained(map, &args, scale))
+}
+
+/// Lobes of a lobe sum that fewer lobes would describe as well: one with
+/// under 1 % of the specularity, or two whose roughnesses differ by under
+/// 2 %.
+fn collapsed_lobes(shape: Shape, args: &[f64]) -> Vec<FitWarning> {
+    if shape.lobes < 2 {
+        return Vec::new();
+    }
+    let index = |a: ShapeArg| shape.index_of(a).expect("the shape's argument");
+    let splits: Vec<f64> = (0..shape.lobes - 1)
+        .map(|j| args[index(ShapeArg::Split(j))])
+        .collect();
+    let size = |k: usize| {
+        let ru = args[index(ShapeArg::RoughU(k))];
+        let rv = shape.index_of(ShapeArg::RoughV(k)).map_or(ru, |i| args[i]);
+        (ru * rv).sqrt()
+    };
+    let mut warnings = Vec::new();
+    for (k, &w) in lobe_weights(&splits).iter().enumerate() {
+        if w < 0.01 {
+            warnings.push(FitWarning::CollapsedLobe {
+                lobe: k + 1,
+                reason: "weight".into(),
+                value: w,
+            });
+        }
+    }
+    for k in 0..shape.lobes - 1 {
+        let (a, b) = (size(k), size(k + 1));
+        let difference = (a - b).abs() / a.max(b);
+        if difference < 0.02 {
+            warnings.push(FitWarning::CollapsedLobe {
+                lobe: k + 1,
+                reason: "roughness".into(),
+                value: difference,
+            });
+        }
+    }
+    warnings
+}
+
 /// What the report needs besides the solution.
 struct Reported<'a> {
     robust: Option<RobustRecord>,
@@ -464,7 +741,6 @@ impl Reported<'_> {
             reason: reason.into(),
         };
         let map = solver.map;
-        let config = solver.config;
         let problem = solver.problem(blocks);
         let (p, dp, material, scale) = problem
             .physical(&u)
@@ -485,15 +761,15 @@ impl Reported<'_> {
         };
 
         // Every material argument by name, then the free scale.
-        let args = material.args().to_vec();
+        let args = material.args().expect("a fitted material").to_vec();
         let mut params = Vec::new();
         let mut warnings = Vec::new();
-        for (a, name) in config.kind.param_names().iter().enumerate() {
+        for (a, name) in map.shape.param_names().iter().enumerate() {
             let estimate = match map.slot_of_arg(a) {
                 Some(i) => {
                     let (stderr, stderr_robust) = physical_error(i);
                     ParamEstimate {
-                        name: (*name).into(),
+                        name: name.clone(),
                         value: args[a],
                         stderr,
                         stderr_robust,
@@ -502,7 +778,7 @@ impl Reported<'_> {
                     }
                 }
                 None => ParamEstimate {
-                    name: (*name).into(),
+                    name: name.clone(),
                     value: args[a],
                     stderr: None,
                     stderr_robust: None,
@@ -558,6 +834,7 @@ impl Reported<'_> {
         if args[3] < 1e-4 {
             warnings.push(FitWarning::DegenerateLobe);
         }
+        warnings.extend(collapsed_lobes(map.shape, &args));
         if let Some(r) = &self.robust
             && !r.settled
         {
@@ -588,6 +865,7 @@ impl Reported<'_> {
             },
             weighting: first.weighting,
             rms_rel: final_pass.rms_rel,
+            e1: problem.e1(&u),
             cost,
             floor: self.floor,
             termination,

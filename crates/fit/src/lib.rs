@@ -37,6 +37,7 @@ pub mod en14501;
 mod fitter;
 mod gram;
 pub mod klems;
+mod lobes;
 mod pair_geometry;
 mod params;
 mod prepare;

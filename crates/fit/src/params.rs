@@ -2,22 +2,23 @@
 //! physical parameters: a logistic for box bounds, `exp` for the positive
 //! scale. All of the fit's bound handling lives here.
 
-use brtf_model::MaterialKind;
-use serde::{Deserialize, Serialize};
+use brtf_model::{Shape, ShapeArg};
 
 /// What one free parameter drives.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Target {
     /// All three colour arguments at once (grey fit).
     Gray,
-    /// One real argument of the material (index into its argument list).
+    /// One flat argument of the material's shape (index into its
+    /// argument list, [`Shape::args`]).
     Arg(usize),
     /// The free overall scale factor for raw-signal data.
     Scale,
 }
 
-/// One free parameter with its physical range.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+/// One free parameter with its physical range (both bounds infinite: the
+/// parameter is unbounded, as the orientation angle).
+#[derive(Debug, Clone, PartialEq)]
 pub struct Slot {
     /// Name as in the fit tables (`red`, `spec`, `rough`, `scale`, ...).
     pub name: String,
@@ -36,11 +37,10 @@ pub const MIN_ROUGHNESS: f64 = 0.002;
 pub const MAX_ROUGHNESS: f64 = 1.0;
 
 /// The free parameters of one fit.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct ParamMap {
-    /// The material type being fitted.
-    #[serde(with = "crate::serde_kind")]
-    pub kind: MaterialKind,
+    /// The shape being fitted.
+    pub shape: Shape,
     /// The free parameters, in optimiser order.
     pub slots: Vec<Slot>,
     /// Material arguments not fitted (colour fixed to 1 under a free scale).
@@ -48,13 +48,14 @@ pub struct ParamMap {
 }
 
 impl ParamMap {
-    /// The free parameters for `kind`: a grey colour (`gray`) or RGB, the
-    /// other real arguments, and optionally a free scale (which fixes the
+    /// The free parameters for `shape`: a grey colour (`gray`) or RGB, the
+    /// other flat arguments, and optionally a free scale (which fixes the
     /// colour to 1, since only scale × colour is identified).
-    pub fn new(kind: MaterialKind, gray: bool, free_scale: bool) -> ParamMap {
-        let names = kind.param_names();
+    pub fn new(shape: Shape, gray: bool, free_scale: bool) -> ParamMap {
+        let names = shape.param_names();
+        let roles = shape.args();
         let mut slots = Vec::new();
-        let mut fixed = vec![0.0; kind.n_args()];
+        let mut fixed = vec![0.0; shape.n_args()];
         if free_scale {
             fixed[..3].copy_from_slice(&[1.0; 3]);
             slots.push(Slot {
@@ -73,7 +74,7 @@ impl ParamMap {
         } else {
             for (i, name) in names.iter().enumerate().take(3) {
                 slots.push(Slot {
-                    name: (*name).into(),
+                    name: name.clone(),
                     target: Target::Arg(i),
                     lo: 0.0,
                     hi: 1.0,
@@ -81,19 +82,23 @@ impl ParamMap {
             }
         }
         for (i, name) in names.iter().enumerate().skip(3) {
-            let (lo, hi) = if name.starts_with("rough") {
-                (MIN_ROUGHNESS, MAX_ROUGHNESS)
-            } else {
-                (0.0, 1.0)
+            let (lo, hi) = match roles[i] {
+                ShapeArg::RoughU(_) | ShapeArg::RoughV(_) => (MIN_ROUGHNESS, MAX_ROUGHNESS),
+                ShapeArg::Orient => (f64::NEG_INFINITY, f64::INFINITY),
+                _ => (0.0, 1.0),
             };
             slots.push(Slot {
-                name: (*name).into(),
+                name: name.clone(),
                 target: Target::Arg(i),
                 lo,
                 hi,
             });
         }
-        ParamMap { kind, slots, fixed }
+        ParamMap {
+            shape,
+            slots,
+            fixed,
+        }
     }
 
     /// The same map with roughness bounded below by `min` (never below
@@ -130,6 +135,9 @@ impl ParamMap {
     /// Physical value of slot `i` for unconstrained `u`, and dp/du.
     pub fn to_physical(&self, i: usize, u: f64) -> (f64, f64) {
         let s = &self.slots[i];
+        if s.lo.is_infinite() {
+            return (u, 1.0);
+        }
         if s.hi.is_infinite() {
             let p = s.lo + u.exp();
             return (p, u.exp());
@@ -152,6 +160,9 @@ impl ParamMap {
     /// Unconstrained value for physical `p` (clamped just inside the bounds).
     pub fn to_unconstrained(&self, i: usize, p: f64) -> f64 {
         let s = &self.slots[i];
+        if s.lo.is_infinite() {
+            return p;
+        }
         if s.hi.is_infinite() {
             return (p - s.lo).max(1e-300).ln();
         }
@@ -176,6 +187,9 @@ impl ParamMap {
     /// True when physical value `p` of slot `i` sits at a bound.
     pub fn at_bound(&self, i: usize, p: f64) -> bool {
         let s = &self.slots[i];
+        if s.lo.is_infinite() {
+            return false;
+        }
         if s.hi.is_infinite() {
             return p <= s.lo + 1e-12;
         }

@@ -187,6 +187,7 @@ pub(crate) fn scan<'a>(
             factors: Vec::new(),
             log_values: Vec::new(),
             channels,
+            cosine_weighted: d.cosine_weighted,
         },
         stats: ScanStats {
             pieces,
@@ -279,6 +280,7 @@ pub(crate) fn subsample<'a>(b: &Block<'_>, target: usize, bright: f64) -> Block<
         factors,
         log_values,
         channels,
+        cosine_weighted: b.cosine_weighted,
     }
 }
 

@@ -4,9 +4,10 @@
 
 use crate::data::{FitSample, PatchPairs};
 use crate::gram::{self, RunColumns};
+use crate::lobes::{LobeModel, LobeTerms};
 use crate::pair_geometry::PairGeometry;
 use crate::params::{ParamMap, Target};
-use brtf_model::{Bsdf, EvalOptions, GeometryBatch, Gradient, Material, PairTerms};
+use brtf_model::{Bsdf, Composite, EvalOptions, GeometryBatch, Gradient, PairTerms};
 use glam::DVec3;
 use levenberg_marquardt::LeastSquaresProblem;
 use nalgebra::{DMatrix, DVector, Dyn, Owned};
@@ -71,6 +72,9 @@ pub(crate) struct Block<'a> {
     /// for the other kinds): the data's side of every log residual.
     pub log_values: Vec<f64>,
     pub channels: usize,
+    /// E1 weighs each sample's misfit by |cos θ_out| (see
+    /// [`crate::IncidenceData::cosine_weighted`]).
+    pub cosine_weighted: bool,
 }
 
 impl Block<'_> {
@@ -222,12 +226,15 @@ impl<'a> Problem<'a> {
     }
 
     /// Physical parameters, their derivatives dp/du, the material and scale.
-    pub(crate) fn physical(&self, u: &DVector<f64>) -> Option<(Vec<f64>, Vec<f64>, Material, f64)> {
+    pub(crate) fn physical(
+        &self,
+        u: &DVector<f64>,
+    ) -> Option<(Vec<f64>, Vec<f64>, Composite, f64)> {
         let (p, dp): (Vec<f64>, Vec<f64>) = (0..self.map.len())
             .map(|i| self.map.to_physical(i, u[i]))
             .unzip();
         let (args, scale) = self.map.material_args(&p);
-        let material = Material::new(self.map.kind, &args, Some(self.orientation)).ok()?;
+        let material = Composite::new(self.map.shape, &args, Some(self.orientation)).ok()?;
         Some((p, dp, material, scale))
     }
 
@@ -285,8 +292,12 @@ impl<'a> Problem<'a> {
                 start = end;
             }
         }
+        let model = match material.single() {
+            Some(m) if self.map.shape.is_single() => Model::Single(Bsdf::new(m, &self.options)),
+            _ => Model::Lobes(LobeModel::new(self.map.shape, &material, &self.options)),
+        };
         let kernel = Kernel {
-            bsdf: Bsdf::new(&material, &self.options),
+            model,
             columns: self
                 .map
                 .slots
@@ -301,6 +312,46 @@ impl<'a> Problem<'a> {
             blocks: self.blocks,
         };
         Some((kernel, chunks))
+    }
+
+    /// E1 at `u`: `Σ ω c |m − d| / Σ ω c |d|` over every sample and
+    /// channel, ω the sample's weight, c its |cos θ_out| for cosine-weighted
+    /// data (see [`crate::FitReport::e1`]); `None` when not finite.
+    pub(crate) fn e1(&self, u: &DVector<f64>) -> Option<f64> {
+        let (kernel, chunks) = self.kernel(u)?;
+        let (blocks, channels) = (self.blocks, self.channels);
+        let sums = |&(b, start, end): &Chunk| -> (f64, f64) {
+            let block = &blocks[b];
+            let (mut misfit, mut total) = (0.0, 0.0);
+            kernel.for_each_value(block, start..end, |i, f| {
+                let s = &block.samples[i];
+                let weight = if block.unit_weights {
+                    1.0
+                } else {
+                    s.weight.max(0.0)
+                };
+                let c = if block.cosine_weighted {
+                    s.view.z.abs()
+                } else {
+                    1.0
+                };
+                for (&m, &y) in f.iter().zip(&s.value).take(channels) {
+                    misfit += weight * c * (kernel.scale * m - y).abs();
+                    total += weight * c * y.abs();
+                }
+            });
+            (misfit, total)
+        };
+        let parts: Vec<(f64, f64)> = if self.n_residuals() >= PARALLEL_ROWS {
+            chunks.par_iter().map(sums).collect()
+        } else {
+            chunks.iter().map(sums).collect()
+        };
+        let (misfit, total) = parts
+            .iter()
+            .fold((0.0, 0.0), |(m, t), (a, b)| (m + a, t + b));
+        let e1 = misfit / total;
+        e1.is_finite().then_some(e1)
     }
 
     /// The cost ½‖r‖² at `u` (`None` when a residual is not finite), from
@@ -355,6 +406,18 @@ impl<'a> Problem<'a> {
                 (9, true) => kernel.gram::<9, true>(*chunk),
                 (10, false) => kernel.gram::<10, false>(*chunk),
                 (10, true) => kernel.gram::<10, true>(*chunk),
+                (11, false) => kernel.gram::<11, false>(*chunk),
+                (11, true) => kernel.gram::<11, true>(*chunk),
+                (12, false) => kernel.gram::<12, false>(*chunk),
+                (12, true) => kernel.gram::<12, true>(*chunk),
+                (13, false) => kernel.gram::<13, false>(*chunk),
+                (13, true) => kernel.gram::<13, true>(*chunk),
+                (14, false) => kernel.gram::<14, false>(*chunk),
+                (14, true) => kernel.gram::<14, true>(*chunk),
+                (15, false) => kernel.gram::<15, false>(*chunk),
+                (15, true) => kernel.gram::<15, true>(*chunk),
+                (16, false) => kernel.gram::<16, false>(*chunk),
+                (16, true) => kernel.gram::<16, true>(*chunk),
                 _ => unreachable!("at most {} parameters", MAX_WIDTH - 1),
             }
         };
@@ -404,9 +467,28 @@ impl<'a> Problem<'a> {
     }
 }
 
+/// The material of a pass.
+enum Model {
+    /// One primitive, its orientation fixed: brtf-model's kernel alone.
+    Single(Bsdf),
+    /// A lobe sum, or a fitted orientation.
+    Lobes(LobeModel),
+}
+
+impl Model {
+    /// The primitive of patch-averaged fits, which take one (lobe sums and
+    /// fitted orientations are refused for them before the fit).
+    fn single(&self) -> &Bsdf {
+        match self {
+            Model::Single(bsdf) => bsdf,
+            Model::Lobes(_) => unreachable!("patch-averaged fits take one primitive"),
+        }
+    }
+}
+
 /// Everything one pass needs per sample.
 struct Kernel<'a> {
-    bsdf: Bsdf,
+    model: Model,
     /// What each free parameter drives, and dp/du.
     columns: Vec<(Target, f64)>,
     scale: f64,
@@ -464,7 +546,7 @@ impl Kernel<'_> {
                 let last = (first + RUN).min(range.end);
                 run.evaluate::<false>(self, block, first..last);
                 for i in first..last {
-                    visit(i, run.value(i - first));
+                    visit(i, run.value(self, i - first));
                 }
             }
         }
@@ -512,14 +594,24 @@ impl Kernel<'_> {
             for first in (start..end).step_by(RUN) {
                 let last = (first + RUN).min(end);
                 run.evaluate::<true>(self, block, first..last);
-                self.put_columns::<W, REPORT>(
-                    &run.terms,
-                    block,
-                    first,
-                    &mut columns,
-                    &mut dr_dm,
-                    &mut sums,
-                );
+                match &self.model {
+                    Model::Single(_) => self.put_columns::<W, REPORT>(
+                        &run.terms,
+                        block,
+                        first,
+                        &mut columns,
+                        &mut dr_dm,
+                        &mut sums,
+                    ),
+                    Model::Lobes(_) => self.put_columns::<W, REPORT>(
+                        &run.lobe_terms,
+                        block,
+                        first,
+                        &mut columns,
+                        &mut dr_dm,
+                        &mut sums,
+                    ),
+                }
                 gram::accumulate::<W, REPORT>(&columns, &mut sums.gram, &mut sums.meat);
             }
         }
@@ -541,7 +633,7 @@ impl Kernel<'_> {
     /// columns, so that the loops are plain array arithmetic.
     fn put_columns<const W: usize, const REPORT: bool>(
         &self,
-        terms: &PairTerms,
+        terms: &impl Terms,
         block: &Block<'_>,
         first: usize,
         columns: &mut RunColumns,
@@ -549,7 +641,7 @@ impl Kernel<'_> {
         sums: &mut GramSums<W>,
     ) {
         let channels = self.channels;
-        let n = terms.len();
+        let n = terms.value_column(0).len();
         let rows = n * channels;
         columns.reset(rows, W);
         dr_dm.clear();
@@ -665,12 +757,11 @@ impl Kernel<'_> {
     ) -> [f64; 3] {
         let (geometry, range) = self.pair_geometry(block, i, scratch);
         let inverse = 1.0 / range.len().max(1) as f64;
+        let bsdf = self.model.single();
         let sum = if self.channels == 1 {
-            self.bsdf
-                .sum_geometry_with_gradient::<1>(geometry, range, grad)
+            bsdf.sum_geometry_with_gradient::<1>(geometry, range, grad)
         } else {
-            self.bsdf
-                .sum_geometry_with_gradient::<3>(geometry, range, grad)
+            bsdf.sum_geometry_with_gradient::<3>(geometry, range, grad)
         };
         for d in grad.d.iter_mut() {
             for c in d.iter_mut() {
@@ -685,7 +776,8 @@ impl Kernel<'_> {
     fn average(&self, block: &Block<'_>, i: usize, scratch: &mut GeometryBatch) -> [f64; 3] {
         let (geometry, range) = self.pair_geometry(block, i, scratch);
         let inverse = 1.0 / range.len().max(1) as f64;
-        self.bsdf
+        self.model
+            .single()
             .sum_geometry::<3>(geometry, range)
             .map(|s| s * inverse)
     }
@@ -702,7 +794,8 @@ impl Kernel<'_> {
             (Some(cached), _) => (&cached.geometry, cached.range(i)),
             (None, Some(pairs)) => {
                 scratch.clear();
-                scratch.extend(pairs.of(i).map(|(l, v)| self.bsdf.geometry(l, v)));
+                let bsdf = self.model.single();
+                scratch.extend(pairs.of(i).map(|(l, v)| bsdf.geometry(l, v)));
                 let n = scratch.len();
                 (&*scratch, 0..n)
             }
@@ -756,6 +849,10 @@ const RUN: usize = 256;
 struct Run {
     geometry: GeometryBatch,
     terms: PairTerms,
+    /// A lobe model's terms, and its turned geometry (fitted orientation).
+    lobe_terms: LobeTerms,
+    turned: [GeometryBatch; 2],
+    views: Vec<DVec3>,
 }
 
 impl Run {
@@ -763,6 +860,9 @@ impl Run {
         Run {
             geometry: GeometryBatch::with_capacity(RUN),
             terms: PairTerms::new(),
+            lobe_terms: LobeTerms::default(),
+            turned: [GeometryBatch::new(), GeometryBatch::new()],
+            views: Vec::new(),
         }
     }
 
@@ -774,35 +874,97 @@ impl Run {
         block: &Block<'_>,
         range: Range<usize>,
     ) {
-        let (geometry, range) = match &block.sample_geometry {
-            Some(cached) => (&**cached, range),
-            None => {
-                self.geometry.clear();
-                for s in &block.samples[range] {
-                    self.geometry
-                        .push(kernel.bsdf.geometry(block.light, s.view));
+        let lobes = match &kernel.model {
+            Model::Single(bsdf) => {
+                let (geometry, range) = match &block.sample_geometry {
+                    Some(cached) => (&**cached, range),
+                    None => {
+                        self.geometry.clear();
+                        for s in &block.samples[range] {
+                            self.geometry.push(bsdf.geometry(block.light, s.view));
+                        }
+                        (&self.geometry, 0..self.geometry.len())
+                    }
+                };
+                let terms = &mut self.terms;
+                match (GRAD, kernel.channels) {
+                    (true, 1) => bsdf.eval_geometry_each_with_gradient::<1>(geometry, range, terms),
+                    (true, _) => bsdf.eval_geometry_each_with_gradient::<3>(geometry, range, terms),
+                    (false, 1) => bsdf.eval_geometry_each::<1>(geometry, range, terms),
+                    (false, _) => bsdf.eval_geometry_each::<3>(geometry, range, terms),
                 }
-                (&self.geometry, 0..self.geometry.len())
+                return;
+            }
+            Model::Lobes(lobes) => lobes,
+        };
+        // A fitted orientation turns the tangent frame: the geometry is the
+        // point's own, and the turned ones give its derivative.
+        let cached = block
+            .sample_geometry
+            .as_deref()
+            .filter(|_| !lobes.oriented());
+        let (geometry, range) = match cached {
+            Some(cached) => (cached, range),
+            None => {
+                self.views.clear();
+                self.views
+                    .extend(block.samples[range].iter().map(|s| s.view));
+                lobes.geometry(0, block.light, &self.views, &mut self.geometry);
+                (&self.geometry, 0..self.views.len())
             }
         };
-        let (bsdf, terms) = (&kernel.bsdf, &mut self.terms);
+        let turned = (GRAD && lobes.oriented()).then(|| {
+            let [minus, plus] = &mut self.turned;
+            lobes.geometry(-1, block.light, &self.views, minus);
+            lobes.geometry(1, block.light, &self.views, plus);
+            [&*minus, &*plus]
+        });
+        let terms = &mut self.lobe_terms;
         match (GRAD, kernel.channels) {
-            (true, 1) => bsdf.eval_geometry_each_with_gradient::<1>(geometry, range, terms),
-            (true, _) => bsdf.eval_geometry_each_with_gradient::<3>(geometry, range, terms),
-            (false, 1) => bsdf.eval_geometry_each::<1>(geometry, range, terms),
-            (false, _) => bsdf.eval_geometry_each::<3>(geometry, range, terms),
+            (true, 1) => terms.evaluate::<true, 1>(lobes, geometry, range, turned),
+            (true, _) => terms.evaluate::<true, 3>(lobes, geometry, range, turned),
+            (false, 1) => terms.evaluate::<false, 1>(lobes, geometry, range, None),
+            (false, _) => terms.evaluate::<false, 3>(lobes, geometry, range, None),
         }
     }
 
     /// Sample `j` of the run's `f`.
     #[inline(always)]
-    fn value(&self, j: usize) -> [f64; 3] {
-        std::array::from_fn(|ch| self.terms.value(j, ch))
+    fn value(&self, kernel: &Kernel<'_>, j: usize) -> [f64; 3] {
+        match kernel.model {
+            Model::Single(_) => std::array::from_fn(|ch| self.terms.value(j, ch)),
+            Model::Lobes(_) => std::array::from_fn(|ch| self.lobe_terms.value(j, ch)),
+        }
     }
 }
 
-/// Widest `[J | r]`: every argument of a material, a free scale, the residual.
-const MAX_WIDTH: usize = brtf_model::MAX_ARGS + 2;
+/// The columns [`Kernel::put_columns`] reads: one primitive's terms or a
+/// lobe model's.
+trait Terms {
+    fn value_column(&self, ch: usize) -> &[f64];
+    fn derivative_column(&self, a: usize, ch: usize) -> Option<&[f64]>;
+}
+
+impl Terms for PairTerms {
+    fn value_column(&self, ch: usize) -> &[f64] {
+        PairTerms::value_column(self, ch)
+    }
+    fn derivative_column(&self, a: usize, ch: usize) -> Option<&[f64]> {
+        PairTerms::derivative_column(self, a, ch)
+    }
+}
+
+impl Terms for LobeTerms {
+    fn value_column(&self, ch: usize) -> &[f64] {
+        LobeTerms::value_column(self, ch)
+    }
+    fn derivative_column(&self, a: usize, ch: usize) -> Option<&[f64]> {
+        LobeTerms::derivative_column(self, a, ch)
+    }
+}
+
+/// Widest `[J | r]`: every argument of a shape, a free scale, the residual.
+const MAX_WIDTH: usize = brtf_model::MAX_SHAPE_ARGS + 2;
 
 /// The triangle `[[R, z], [0, ρ]]` (column-major, `width × width`) of the
 /// augmented Gram matrix `G = [J | r]ᵀ[J | r]` (upper triangle, row-major):

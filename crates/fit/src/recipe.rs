@@ -648,6 +648,7 @@ impl PreparedMeasurement {
                 .collect(),
             gates: self.gates.clone(),
             weighting: self.weighting,
+            cosine_weighted: !matches!(self.conversion, Conversion::Bsdf),
             // Shared, not copied, when every sample is fitted: a Klems
             // side's pairs take hundreds of MB.
             patch_pairs: self.patch_pairs.as_ref().map(|pairs| {

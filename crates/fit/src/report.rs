@@ -157,6 +157,12 @@ pub struct FitReport {
     pub weighting: Weighting,
     /// RMS of `(m − y)/sqrt(y² + floor²)` over all samples and channels.
     pub rms_rel: f64,
+    /// E1, the share of the measured light the material puts in the wrong
+    /// place: `Σ ω |m − d| / Σ ω |d|` over the fitted samples and channels,
+    /// ω the sample's weight (its solid angle by default), m and d in the
+    /// file's quantity (times |cos θ_out| for DSF and raw-signal files).
+    #[serde(default)]
+    pub e1: Option<f64>,
     /// ½ Σ r² at the solution (the optimiser's objective).
     pub cost: f64,
     /// The floor used by relative/log residuals.
@@ -269,6 +275,18 @@ pub enum FitWarning {
         /// The comparison.
         check: crate::adequacy::ResidualCheck,
     },
+    /// A lobe of a lobe sum carries almost none of the specularity, or two
+    /// lobes have (nearly) one roughness: fewer lobes describe the data as
+    /// well.
+    CollapsedLobe {
+        /// The lobe (1-based).
+        lobe: usize,
+        /// Why: `weight` (its share of the specularity) or `roughness`
+        /// (equal to the next lobe's).
+        reason: String,
+        /// Its share of the specularity, or the roughnesses' relative difference.
+        value: f64,
+    },
 }
 
 impl std::fmt::Display for FitWarning {
@@ -315,6 +333,25 @@ impl std::fmt::Display for FitWarning {
                 f,
                 "the model's peak is {degrees:.1}° from the data's: the lobe is in the wrong place"
             ),
+            FitWarning::CollapsedLobe {
+                lobe,
+                reason,
+                value,
+            } => match reason.as_str() {
+                "weight" => write!(
+                    f,
+                    "lobe {lobe} carries {:.2}% of the specularity: it has collapsed, and a fit \
+                     with one lobe fewer describes the data as well",
+                    100.0 * value
+                ),
+                _ => write!(
+                    f,
+                    "lobes {lobe} and {} have the same roughness (within {:.1}%): they have \
+                     collapsed into one",
+                    lobe + 1,
+                    100.0 * value
+                ),
+            },
             FitWarning::ResidualKindSensitive { check } => write!(
                 f,
                 "{} moves from {:.4} to {:.4} ({:.0}%) when fitted with {:?} residuals: \

@@ -7,7 +7,7 @@ use crate::config::FitConfig;
 use crate::recipe::{Conversion, Recipe};
 use crate::report::FitReport;
 use crate::table::{Interpolation, ParamTable};
-use brtf_model::{EvalOptions, Material};
+use brtf_model::{Composite, EvalOptions, Material};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -234,10 +234,11 @@ impl FitResult {
     fn validate(&self) -> Result<(), String> {
         if let Some(table) = &self.table {
             table.validate().map_err(|e| e.to_string())?;
-            if table.kind != self.config.kind {
+            if table.shape() != self.config.shape() {
                 return Err(format!(
                     "the table is of {}, the fit of {}",
-                    table.kind, self.config.kind
+                    table.shape(),
+                    self.config.shape()
                 ));
             }
         }
@@ -250,14 +251,15 @@ impl FitResult {
                 ));
             }
         }
-        let n = self.config.kind.param_names().len();
+        let shape =
+            brtf_model::Shape::new(self.config.kind, self.config.lobes, self.config.oriented)?;
+        let n = shape.n_args();
         for r in self.incidences.iter().chain(&self.global) {
             if r.material_args.len() != n || !r.material_args.iter().all(|a| a.is_finite()) {
                 return Err(format!(
-                    "{}: {} material arguments, a {} has {n} finite ones",
+                    "{}: {} material arguments, a {shape} has {n} finite ones",
                     r.source,
                     r.material_args.len(),
-                    self.config.kind
                 ));
             }
         }
@@ -317,22 +319,33 @@ impl FitResult {
         self.config.options
     }
 
-    /// Material of a report's fitted arguments.
-    pub fn material_of(&self, report: &FitReport) -> Option<Material> {
-        Material::new(
-            self.config.kind,
+    /// The material (any shape) of a report's fitted arguments.
+    pub fn composite_of(&self, report: &FitReport) -> Option<Composite> {
+        Composite::new(
+            self.config.shape(),
             &report.material_args,
             Some(DVec3::from_array(self.config.orientation)),
         )
         .ok()
     }
 
-    /// The static material: the all-incidence fit, else the first incidence.
-    pub fn static_material(&self) -> Option<Material> {
+    /// The one primitive of a one-lobe fit's report (`None` for a lobe sum).
+    pub fn material_of(&self, report: &FitReport) -> Option<Material> {
+        self.composite_of(report)?.single().copied()
+    }
+
+    /// The static material (any shape): the all-incidence fit, else the
+    /// first incidence.
+    pub fn static_composite(&self) -> Option<Composite> {
         self.global
             .as_ref()
             .or(self.incidences.first())
-            .and_then(|r| self.material_of(r))
+            .and_then(|r| self.composite_of(r))
+    }
+
+    /// The static material of a one-lobe fit (`None` for a lobe sum).
+    pub fn static_material(&self) -> Option<Material> {
+        self.static_composite()?.single().copied()
     }
 
     /// The input file of incidence `index`.
@@ -354,34 +367,54 @@ impl FitResult {
             .any(InputFile::is_klems_back_side)
     }
 
-    /// The material at θ_in: the table's, else the incidence's own fit
-    /// (`report`), else the static material.
-    pub fn material_at(&self, theta_in: f64, report: Option<&FitReport>) -> Option<Material> {
+    /// The material (any shape) at θ_in: the table's, else the
+    /// incidence's own fit (`report`), else the static material.
+    pub fn composite_at(&self, theta_in: f64, report: Option<&FitReport>) -> Option<Composite> {
         if let Some(table) = &self.table {
-            return table.at(theta_in).ok().map(|l| l.material);
+            return table.composite_at(theta_in).ok().map(|(m, _)| m);
         }
         report
-            .and_then(|r| self.material_of(r))
-            .or_else(|| self.static_material())
+            .and_then(|r| self.composite_of(r))
+            .or_else(|| self.static_composite())
     }
 
-    /// [`Self::material_at`] for a light at (`theta_in`, `phi_in`), φ_in in
-    /// the data's frame (as [`FitReport::phi_in`]): a table that follows
-    /// φ_in gives its parameters at that azimuth.
+    /// [`Self::composite_at`] of a one-lobe fit (`None` for a lobe sum).
+    pub fn material_at(&self, theta_in: f64, report: Option<&FitReport>) -> Option<Material> {
+        self.composite_at(theta_in, report)?.single().copied()
+    }
+
+    /// [`Self::composite_at`] for a light at (`theta_in`, `phi_in`), φ_in
+    /// in the data's frame (as [`FitReport::phi_in`]): a table that
+    /// follows φ_in gives its parameters at that azimuth.
+    pub fn composite_at_direction(
+        &self,
+        theta_in: f64,
+        phi_in: f64,
+        report: Option<&FitReport>,
+    ) -> Option<Composite> {
+        match &self.table {
+            Some(table) if table.depends_on_azimuth() => {
+                let phi =
+                    crate::azimuth_from_u(self.config.orientation, self.is_mirrored_side(), phi_in);
+                table
+                    .composite_at_direction(theta_in, phi)
+                    .ok()
+                    .map(|(m, _)| m)
+            }
+            _ => self.composite_at(theta_in, report),
+        }
+    }
+
+    /// [`Self::composite_at_direction`] of a one-lobe fit.
     pub fn material_at_direction(
         &self,
         theta_in: f64,
         phi_in: f64,
         report: Option<&FitReport>,
     ) -> Option<Material> {
-        match &self.table {
-            Some(table) if table.depends_on_azimuth() => {
-                let phi =
-                    crate::azimuth_from_u(self.config.orientation, self.is_mirrored_side(), phi_in);
-                table.at_direction(theta_in, phi).ok().map(|l| l.material)
-            }
-            _ => self.material_at(theta_in, report),
-        }
+        self.composite_at_direction(theta_in, phi_in, report)?
+            .single()
+            .copied()
     }
 
     /// `params.csv`: one row per incidence, then the all-incidence fit as a
@@ -396,7 +429,8 @@ impl FitResult {
         header.extend(names.iter().map(|n| n.to_string()));
         header.extend(names.iter().map(|n| format!("{n}_stderr")));
         header.extend(["rms_rel".into(), "cost".into(), "termination".into()]);
-        // The adequacy columns follow the contract's (empty without them).
+        // E1 and the adequacy columns follow the contract's (empty without them).
+        header.push("e1".into());
         header.extend(["rho_dh_data".into(), "rho_dh_model".into()]);
         w.write_record(&header)?;
         let row = |r: &FitReport, theta: String, phi: String| -> Vec<String> {
@@ -415,6 +449,7 @@ impl FitResult {
             ]);
             let adequacy = r.adequacy.as_ref();
             let number = |x: Option<f64>| x.map_or_else(String::new, |v| format!("{v:.6}"));
+            v.push(number(r.e1));
             v.push(number(adequacy.and_then(|a| a.rho_data)));
             v.push(number(adequacy.map(|a| a.rho_model)));
             v

@@ -264,10 +264,10 @@ pub fn fit_set_with_data(
     // Klems incidences come in θ rings of azimuth patches: the table
     // averages each ring over φ_in, and an anisotropic type's also keeps
     // each ring over φ_in.
-    let (kind, orientation, method) = (config.kind, config.orientation, options.interpolation);
+    let (kind, orientation, method) = (config.shape(), config.orientation, options.interpolation);
     let built = if recipe.patch_average.is_none() {
         ParamTable::from_reports(kind, orientation, &reports, method)
-    } else if kind.is_anisotropic() {
+    } else if kind.kind.is_anisotropic() {
         // The back side's frame is mirrored.
         let mirrored = inputs.iter().any(|i| i.file.is_klems_back_side());
         ParamTable::from_reports_over_azimuth(kind, orientation, &reports, method, mirrored)
@@ -399,18 +399,12 @@ fn instrument_scale(
     report: &FitReport,
     rho: f64,
 ) -> Result<f64, FitSetError> {
-    let material = brtf_model::Material::new(
-        config.kind,
-        &report.material_args,
-        Some(glam::DVec3::from_array(config.orientation)),
-    )
-    .map_err(|e| {
+    let bsdf = diagnose::fitted_bsdf(config, report).ok_or_else(|| {
         FitSetError::Fit(FitError::Failed {
             origin: report.source.clone(),
-            reason: e.to_string(),
+            reason: "the fitted arguments are not a valid material".into(),
         })
     })?;
-    let bsdf = brtf_model::Bsdf::new(&material, &config.options);
     let (rho_model, _) = diagnose::model_albedo(prepared, &bsdf);
     let measured = diagnose::measured_integrals(prepared, data, &bsdf, report.scale);
     let (data, model) = measured.front.unwrap_or((0.0, 0.0));

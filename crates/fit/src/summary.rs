@@ -9,12 +9,11 @@ use std::path::Path;
 /// The summary of `result`, written into `out`.
 pub fn summary(result: &FitResult, out: &Path) -> String {
     let mut s = String::new();
-    let kind = result.config.kind;
     let _ = writeln!(
         s,
         "brtf fit: {} {} ({} variant), {} incidence(s) -> {}",
         result.name,
-        kind,
+        result.config.shape(),
         result.config.options.variant,
         result.incidences.len(),
         out.display()
@@ -39,7 +38,7 @@ pub fn summary(result: &FitResult, out: &Path) -> String {
     for n in &names {
         let _ = write!(s, " {:>17}", n);
     }
-    let _ = writeln!(s, " {:>8} {:>8}  termination", "rms_rel", "ms");
+    let _ = writeln!(s, " {:>7} {:>8} {:>8}  termination", "E1", "rms_rel", "ms");
     let mut line = |label: String, r: &FitReport| {
         let _ = write!(s, "{:>8} {:>7}", label, r.n_points);
         for p in &r.params {
@@ -63,10 +62,12 @@ pub fn summary(result: &FitResult, out: &Path) -> String {
                 }
             }
         }
+        let e1 =
+            r.e1.map_or_else(|| "–".to_string(), |e| format!("{:.1}%", 100.0 * e));
         let _ = writeln!(
             s,
-            " {:>8.4} {:>8.0}  {}",
-            r.rms_rel, r.elapsed_ms, r.termination
+            " {:>7} {:>8.4} {:>8.0}  {}",
+            e1, r.rms_rel, r.elapsed_ms, r.termination
         );
     };
     for r in &result.incidences {
@@ -98,14 +99,26 @@ pub fn summary(result: &FitResult, out: &Path) -> String {
         }
     }
     if let Some(g) = &result.global {
+        let shape = result.config.shape();
         let args: Vec<String> = g.material_args.iter().map(|a| format!("{a:.6}")).collect();
-        let _ = writeln!(
-            s,
-            "\nall-incidence material: void {kind} {} 0 0 {} {}",
-            result.name,
-            args.len(),
-            args.join(" ")
-        );
+        if shape.is_single() {
+            let _ = writeln!(
+                s,
+                "\nall-incidence material: void {} {} 0 0 {} {}",
+                shape.kind,
+                result.name,
+                args.len(),
+                args.join(" ")
+            );
+        } else {
+            let named: Vec<String> = shape
+                .param_names()
+                .iter()
+                .zip(&args)
+                .map(|(n, a)| format!("{n}={a}"))
+                .collect();
+            let _ = writeln!(s, "\nall-incidence material: {shape}: {}", named.join(" "));
+        }
     }
     s
 }
@@ -203,6 +216,7 @@ fn warning_kind(w: &crate::FitWarning) -> String {
         W::RobustNotSettled { .. } => "robust reweighting not settled".into(),
         W::EnergyMismatch { .. } => "data and model ρ_dh/τ_dh differ".into(),
         W::PeakOffset { .. } => "model peak away from the data's".into(),
+        W::CollapsedLobe { .. } => "a lobe of the lobe sum collapsed".into(),
         W::ResidualKindSensitive { check } => format!(
             "{} moves with another residual kind ({:?})",
             check.param, check.residual

@@ -10,7 +10,7 @@
 //! are.
 
 use crate::report::FitReport;
-use brtf_model::{Material, MaterialKind, ModelError};
+use brtf_model::{Composite, Material, MaterialKind, ModelError, Shape, ShapeArg};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
@@ -40,6 +40,9 @@ pub enum TableError {
     /// The interpolated parameters are not a valid material.
     #[error("interpolated parameters are not a valid material: {0}")]
     Material(#[from] ModelError),
+    /// The table holds a lobe sum where one primitive is asked for.
+    #[error("the table holds a lobe sum, not one primitive")]
+    LobeSum,
     /// A stored table is not one brtf could have made.
     #[error("invalid θ_in table: {0}")]
     Invalid(String),
@@ -51,6 +54,12 @@ pub struct ParamTable {
     /// The material type.
     #[serde(with = "crate::serde_kind")]
     pub kind: MaterialKind,
+    /// Specular lobes of the shape (see [`brtf_model::Shape`]).
+    #[serde(default = "one_lobe")]
+    pub lobes: usize,
+    /// The shape's orientation is an argument (`orient`).
+    #[serde(default)]
+    pub oriented: bool,
     /// Orientation of the `*2` types.
     pub orientation: [f64; 3],
     /// Interpolation method.
@@ -64,6 +73,10 @@ pub struct ParamTable {
     /// incidences over φ_in, so the parameters follow (θ_in, φ_in).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub azimuth: Option<Vec<AzimuthRing>>,
+}
+
+fn one_lobe() -> usize {
+    1
 }
 
 /// The azimuth of a table's rings ([`AzimuthRing::phi_in`]) for a light
@@ -120,7 +133,7 @@ pub struct TableLookup {
 impl ParamTable {
     /// Builds the table from per-incidence reports (sorted by θ_in here).
     pub fn from_reports(
-        kind: MaterialKind,
+        shape: Shape,
         orientation: [f64; 3],
         reports: &[FitReport],
         method: Interpolation,
@@ -136,8 +149,20 @@ impl ParamTable {
         if let Some(w) = rows.windows(2).find(|w| (w[1].0 - w[0].0).abs() < 1e-9) {
             return Err(TableError::DuplicateTheta(w[0].0));
         }
+        // A fitted orientation is an angle modulo 180°: each row's is taken
+        // within 90° of the row before, so that interpolation turns the
+        // short way.
+        if let Some(o) = shape.index_of(ShapeArg::Orient) {
+            for k in 1..rows.len() {
+                let before = rows[k - 1].1[o];
+                let angle = &mut rows[k].1[o];
+                *angle -= 180.0 * ((*angle - before) / 180.0).round();
+            }
+        }
         Ok(ParamTable {
-            kind,
+            kind: shape.kind,
+            lobes: shape.lobes,
+            oriented: shape.oriented,
             orientation,
             method,
             theta_in: rows.iter().map(|r| r.0).collect(),
@@ -151,7 +176,7 @@ impl ParamTable {
     /// arguments are averaged over its incidences (over φ_in), which suits
     /// isotropic materials; rows with one incidence are kept as they are.
     pub fn from_reports_phi_averaged(
-        kind: MaterialKind,
+        shape: Shape,
         orientation: [f64; 3],
         reports: &[FitReport],
         method: Interpolation,
@@ -174,7 +199,9 @@ impl ParamTable {
             return Err(TableError::NeedTwoIncidences(rings.len()));
         }
         Ok(ParamTable {
-            kind,
+            kind: shape.kind,
+            lobes: shape.lobes,
+            oriented: shape.oriented,
             orientation,
             method,
             theta_in: rings.iter().map(|r| r.0).collect(),
@@ -191,13 +218,13 @@ impl ParamTable {
     /// [`azimuth_from_u`]'s: counted from u, and negated for data described
     /// in a mirrored frame (`mirrored`: the back side of a Klems file).
     pub fn from_reports_over_azimuth(
-        kind: MaterialKind,
+        shape: Shape,
         orientation: [f64; 3],
         reports: &[FitReport],
         method: Interpolation,
         mirrored: bool,
     ) -> Result<ParamTable, TableError> {
-        let mut table = Self::from_reports_phi_averaged(kind, orientation, reports, method)?;
+        let mut table = Self::from_reports_phi_averaged(shape, orientation, reports, method)?;
         let mut rings: Vec<Vec<(f64, Vec<f64>)>> = vec![Vec::new(); table.theta_in.len()];
         for r in reports {
             let row = table
@@ -221,6 +248,32 @@ impl ParamTable {
         }
         table.azimuth = Some(azimuth);
         Ok(table)
+    }
+
+    /// The shape of the tabulated material.
+    pub fn shape(&self) -> Shape {
+        Shape {
+            kind: self.kind,
+            lobes: self.lobes,
+            oriented: self.oriented,
+        }
+    }
+
+    /// The material of flat arguments `args`.
+    fn composite(&self, args: &[f64]) -> Result<Composite, TableError> {
+        let shape =
+            Shape::new(self.kind, self.lobes, self.oriented).map_err(TableError::Invalid)?;
+        Ok(Composite::new(
+            shape,
+            args,
+            Some(DVec3::from_array(self.orientation)),
+        )?)
+    }
+
+    /// One primitive of a one-lobe table (an error for a lobe sum).
+    fn primitive(&self, args: &[f64]) -> Result<Material, TableError> {
+        let material = self.composite(args)?;
+        material.single().copied().ok_or(TableError::LobeSum)
     }
 
     /// Measured θ_in range.
@@ -254,16 +307,17 @@ impl ParamTable {
         if let Some(w) = self.theta_in.windows(2).find(|w| w[1] <= w[0]) {
             return invalid(format!("θ_in is not ascending at {}° → {}°", w[0], w[1]));
         }
-        let n = self.kind.param_names().len();
+        let shape =
+            Shape::new(self.kind, self.lobes, self.oriented).map_err(TableError::Invalid)?;
+        let n = shape.n_args();
         for (row, t) in self.args.iter().zip(&self.theta_in) {
             if row.len() != n {
                 return invalid(format!(
-                    "the row at {t}° has {} arguments, a {} has {n}",
-                    row.len(),
-                    self.kind
+                    "the row at {t}° has {} arguments, a {shape} has {n}",
+                    row.len()
                 ));
             }
-            Material::new(self.kind, row, Some(DVec3::from_array(self.orientation)))?;
+            self.composite(row)?;
         }
         if let Some(rings) = &self.azimuth {
             if rings.len() != self.theta_in.len() {
@@ -291,12 +345,11 @@ impl ParamTable {
                 for row in &ring.args {
                     if row.len() != n {
                         return invalid(format!(
-                            "the ring at {t}° has a row of {} arguments, a {} has {n}",
-                            row.len(),
-                            self.kind
+                            "the ring at {t}° has a row of {} arguments, a {shape} has {n}",
+                            row.len()
                         ));
                     }
-                    Material::new(self.kind, row, Some(DVec3::from_array(self.orientation)))?;
+                    self.composite(row)?;
                 }
             }
         }
@@ -324,11 +377,29 @@ impl ParamTable {
         }
     }
 
-    /// The material for a light at (`theta_in`, `phi_in`).
+    /// The material for a light at (`theta_in`, `phi_in`) (one-lobe tables).
     pub fn at_direction(&self, theta_in: f64, phi_in: f64) -> Result<TableLookup, TableError> {
         let (args, clamped) = self.args_at_direction(theta_in, phi_in);
-        let material = Material::new(self.kind, &args, Some(DVec3::from_array(self.orientation)))?;
+        let material = self.primitive(&args)?;
         Ok(TableLookup { material, clamped })
+    }
+
+    /// The material (any shape) for a light at (`theta_in`, `phi_in`), and
+    /// whether θ_in was outside the table.
+    pub fn composite_at_direction(
+        &self,
+        theta_in: f64,
+        phi_in: f64,
+    ) -> Result<(Composite, bool), TableError> {
+        let (args, clamped) = self.args_at_direction(theta_in, phi_in);
+        Ok((self.composite(&args)?, clamped))
+    }
+
+    /// The material (any shape) at `theta_in`, and whether θ_in was
+    /// outside the table.
+    pub fn composite_at(&self, theta_in: f64) -> Result<(Composite, bool), TableError> {
+        let (args, clamped) = self.args_at(theta_in);
+        Ok((self.composite(&args)?, clamped))
     }
 
     /// Each argument interpolated over θ_in through the rows' values
@@ -350,10 +421,10 @@ impl ParamTable {
         (args, clamped)
     }
 
-    /// The material at `theta_in`.
+    /// The material at `theta_in` (one-lobe tables).
     pub fn at(&self, theta_in: f64) -> Result<TableLookup, TableError> {
         let (args, clamped) = self.args_at(theta_in);
-        let material = Material::new(self.kind, &args, Some(DVec3::from_array(self.orientation)))?;
+        let material = self.primitive(&args)?;
         Ok(TableLookup { material, clamped })
     }
 }

@@ -80,6 +80,7 @@ fn synth(material: &Material, theta_in: f64, phi_in: f64, noise: f64, seed: u64)
         gates: Vec::new(),
         weighting: brtf_fit::Weighting::Caller,
         patch_pairs: None,
+        cosine_weighted: false,
     }
 }
 
@@ -209,7 +210,7 @@ fn global_fit_and_interpolated_table() {
         .map(|d| fit_incidence(d, &config).unwrap())
         .collect();
     let table = ParamTable::from_reports(
-        MaterialKind::Metal,
+        brtf_model::Shape::single(MaterialKind::Metal),
         [1.0, 0.0, 0.0],
         &reports,
         Interpolation::Pchip,
@@ -220,7 +221,7 @@ fn global_fit_and_interpolated_table() {
     assert!((mid.material.args()[4] - 0.06).abs() < 1e-6);
     assert!(table.at(75.0).unwrap().clamped);
     let single = ParamTable::from_reports(
-        MaterialKind::Metal,
+        brtf_model::Shape::single(MaterialKind::Metal),
         [1.0, 0.0, 0.0],
         &reports[..1],
         Interpolation::Pchip,
@@ -302,6 +303,7 @@ fn narrow_lobe_on_a_dense_uniform_grid_is_recovered() {
             gates: Vec::new(),
             weighting: brtf_fit::Weighting::Caller,
             patch_pairs: None,
+            cosine_weighted: false,
         };
         let report = fit_incidence(&data, &FitConfig::new(MaterialKind::Metal)).unwrap();
         let (spec, fitted_rough) = (

@@ -133,6 +133,19 @@ impl RgbBatch {
         [self.r[i], self.g[i], self.b[i]]
     }
 
+    /// Adds `w ×` pair `i` of `other` to pair `i`.
+    pub fn add_scaled(&mut self, w: f64, other: &RgbBatch) {
+        for (c, o) in [
+            (&mut self.r, &other.r),
+            (&mut self.g, &other.g),
+            (&mut self.b, &other.b),
+        ] {
+            for (x, y) in c.iter_mut().zip(o) {
+                *x += w * y;
+            }
+        }
+    }
+
     /// Sets all three channels to `n` zeros.
     pub fn resize(&mut self, n: usize) {
         for c in [&mut self.r, &mut self.g, &mut self.b] {

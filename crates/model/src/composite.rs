@@ -457,6 +457,25 @@ impl CompositeBsdf {
         (mirror, through)
     }
 
+    /// [`Bsdf::eval_batch`] of the sum: `out` gets `Σ w_k f_k` of every
+    /// pair (one lobe: that lobe's values as they are).
+    pub fn eval_batch(
+        &self,
+        light: &crate::Directions,
+        view: &crate::Directions,
+        out: &mut crate::RgbBatch,
+    ) {
+        if let [(_, bsdf)] = self.parts.as_slice() {
+            return bsdf.eval_batch(light, view, out);
+        }
+        let mut part = crate::RgbBatch::default();
+        out.resize(light.len());
+        for (w, bsdf) in &self.parts {
+            bsdf.eval_batch(light, view, &mut part);
+            out.add_scaled(*w, &part);
+        }
+    }
+
     fn weighted(&self, f: impl Fn(&Bsdf) -> Rgb) -> Rgb {
         let mut sum = [0.0; 3];
         for (w, b) in &self.parts {

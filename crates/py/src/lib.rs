@@ -17,7 +17,7 @@ use pyo3::prelude::*;
 #[pyfunction(name = "fit")]
 #[pyo3(signature = (inputs, model = "metal", *, gray = false, residual = "absolute", loss = "none",
     name = None, variant = "radiance", fresnel_k = None, source_omega = 0.0,
-    orientation = [1.0, 0.0, 0.0], floor = None, colour = "xyz", weights = "solid_angle",
+    orientation = None, lobes = 1, floor = None, colour = "xyz", weights = "solid_angle",
     multistart = true, theta_cap = brtf_gonio::DEFAULT_THETA_CAP_DEG, beam_mask = 3.0,
     hemisphere = None, min_value = None, mask_holder = false, beam_integral = None, rho = None,
     free_scale = false, interpolation = "pchip", adequacy = true, side = None, incidences = None,
@@ -34,7 +34,8 @@ fn fit_set(
     variant: &str,
     fresnel_k: Option<&Bound<'_, PyAny>>,
     source_omega: f64,
-    orientation: [f64; 3],
+    orientation: Option<[f64; 3]>,
+    lobes: usize,
     floor: Option<f64>,
     colour: &str,
     weights: &str,
@@ -59,7 +60,7 @@ fn fit_set(
         Some(k) => material::parse_fresnel_k(k)?,
         None => brtf_model::FRESNEL_K_CLASSIC,
     };
-    if orientation.iter().all(|c| *c == 0.0) {
+    if orientation.is_some_and(|o| o.iter().all(|c| *c == 0.0)) {
         return Err(errors::model(
             "orientation needs three numbers x, y, z, not all zero",
         ));
@@ -70,6 +71,7 @@ fn fit_set(
         fresnel_k,
         source_omega,
         orientation,
+        lobes,
         residual: word("residual", residual)?,
         floor,
         loss: loss

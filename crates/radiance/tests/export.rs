@@ -35,6 +35,7 @@ fn report(kind: MaterialKind, theta_in: f64, args: &[f64]) -> FitReport {
         gates: Vec::new(),
         weighting: brtf_fit::Weighting::Caller,
         rms_rel: 0.0421,
+        e1: None,
         cost: 7.5,
         floor: 0.01,
         termination: Termination::Converged {
@@ -61,8 +62,13 @@ fn fit(
     let mut config = FitConfig::new(kind);
     config.options = EvalOptions::with_variant(variant);
     let table = (rows.len() > 1).then(|| {
-        ParamTable::from_reports(kind, config.orientation, &incidences, Interpolation::Pchip)
-            .unwrap()
+        ParamTable::from_reports(
+            config.shape(),
+            config.orientation,
+            &incidences,
+            Interpolation::Pchip,
+        )
+        .unwrap()
     });
     FitResult {
         schema: brtf_fit::FIT_JSON_SCHEMA,

@@ -232,6 +232,8 @@ fn table_materials_render_with_the_parameters_of_the_incidence() {
     let table = ParamTable {
         azimuth: None,
         kind: MaterialKind::Metal,
+        lobes: 1,
+        oriented: false,
         orientation: [1.0, 0.0, 0.0],
         method: Interpolation::Pchip,
         theta_in: vec![0.0, 30.0, 60.0],

@@ -134,6 +134,8 @@ fn table_shader_uses_the_light_angle() {
     let table = ParamTable {
         azimuth: None,
         kind: MaterialKind::Plastic,
+        lobes: 1,
+        oriented: false,
         orientation: [1.0, 0.0, 0.0],
         method: Interpolation::Linear,
         theta_in: vec![0.0, 40.0, 80.0],
@@ -186,6 +188,8 @@ fn azimuth_table_shader_uses_the_light_azimuth() {
     let mut table = ParamTable {
         azimuth: None,
         kind: MaterialKind::Trans2,
+        lobes: 1,
+        oriented: false,
         orientation: [1.0, 0.0, 0.0],
         method: Interpolation::Pchip,
         theta_in: Vec::new(),

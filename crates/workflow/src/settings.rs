@@ -27,8 +27,11 @@ pub struct FitSettings {
     pub fresnel_k: f64,
     /// The source's solid angle, sr.
     pub source_omega: f64,
-    /// Orientation vector of the anisotropic types.
-    pub orientation: [f64; 3],
+    /// Orientation vector of the anisotropic types; `None`: fitted (the
+    /// in-plane angle `orient`) for gonio scans, +x for Klems XML.
+    pub orientation: Option<[f64; 3]>,
+    /// Specular lobes over the one diffuse base (plastic and metal types).
+    pub lobes: usize,
     /// How model and data are compared.
     pub residual: ResidualKind,
     /// Floor of relative and log residuals.
@@ -78,7 +81,8 @@ impl FitSettings {
             variant: Variant::default(),
             fresnel_k: FRESNEL_K_CLASSIC,
             source_omega: 0.0,
-            orientation: [1.0, 0.0, 0.0],
+            orientation: None,
+            lobes: 1,
             residual: ResidualKind::default(),
             floor: None,
             loss: RobustLoss::None,
@@ -135,7 +139,11 @@ impl FitSettings {
         config.options.variant = self.variant;
         config.options.fresnel_k = self.fresnel_k;
         config.options.source_omega = self.source_omega;
-        config.orientation = self.orientation;
+        config.orientation = self.orientation.unwrap_or([1.0, 0.0, 0.0]);
+        config.oriented = self.model.is_anisotropic() && !klems && self.orientation.is_none();
+        config.lobes = self.lobes;
+        brtf_model::Shape::new(self.model, self.lobes, config.oriented)
+            .map_err(WorkflowError::Usage)?;
         config.gray = self.gray;
         config.free_scale = self.free_scale;
         config.residual = self.residual;

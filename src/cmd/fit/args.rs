@@ -46,14 +46,14 @@ pub(crate) struct FitArgs {
     /// Solid angle of the instrument's source in sr, modelled as rtrace's widening.
     #[arg(long, default_value_t = 0.0)]
     pub source_omega: f64,
-    /// Orientation vector of the *2 models, `x,y,z`.
-    #[arg(
-        long,
-        default_value = "1,0,0",
-        value_delimiter = ',',
-        allow_hyphen_values = true
-    )]
-    pub orientation: Vec<f64>,
+    /// Orientation vector of the *2 models, `x,y,z` [default: fitted, the
+    /// in-plane angle `orient`; +x for Klems XML].
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    pub orientation: Option<Vec<f64>>,
+    /// Specular lobes over the one diffuse base, 1 to 3 (plastic, metal,
+    /// plastic2, metal2): exported as a mixfunc of one primitive per lobe.
+    #[arg(long, default_value_t = 1)]
+    pub lobes: usize,
     /// How model and data are compared.
     #[arg(long, value_parser = words::<ResidualKind>(), default_value_t = ResidualKind::Absolute)]
     pub residual: ResidualKind,
@@ -135,18 +135,20 @@ impl FitArgs {
         let Some(model) = self.model else {
             anyhow::bail!("--model is needed to fit measurement files");
         };
-        let Ok(orientation) = <[f64; 3]>::try_from(&self.orientation[..]) else {
-            anyhow::bail!("--orientation needs three numbers x,y,z, not all zero");
+        let orientation = match &self.orientation {
+            None => None,
+            Some(v) => match <[f64; 3]>::try_from(&v[..]) {
+                Ok(o) if o.iter().any(|c| *c != 0.0) => Some(o),
+                _ => anyhow::bail!("--orientation needs three numbers x,y,z, not all zero"),
+            },
         };
-        if orientation.iter().all(|c| *c == 0.0) {
-            anyhow::bail!("--orientation needs three numbers x,y,z, not all zero");
-        }
         Ok(FitSettings {
             gray: self.gray,
             variant: self.formula.variant,
             fresnel_k: self.formula.fresnel_k,
             source_omega: self.source_omega,
             orientation,
+            lobes: self.lobes,
             residual: self.residual,
             floor: self.floor,
             loss: self.loss,

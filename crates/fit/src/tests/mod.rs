@@ -77,6 +77,7 @@ pub(crate) fn report(kind: MaterialKind, theta_in: f64, args: &[f64], scale: f64
         gates: Vec::new(),
         weighting: Weighting::Caller,
         rms_rel: 0.0,
+        e1: None,
         cost: 0.0,
         floor: 0.0,
         termination: Termination::Converged {
@@ -138,5 +139,6 @@ pub(crate) fn synth(
         gates: Vec::new(),
         weighting: Weighting::Caller,
         patch_pairs: None,
+        cosine_weighted: false,
     }
 }

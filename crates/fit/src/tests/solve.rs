@@ -161,7 +161,7 @@ fn a_run_out_of_budget_loses_patience_where_the_final_stage_converges() {
     let truth = [0.8, 0.8, 0.8, 0.9, 0.03];
     let data = synth(&material(kind, &truth), 30.0, 1, 0.0, 4);
     let config = FitConfig::new(kind);
-    let map = ParamMap::new(kind, true, false);
+    let map = ParamMap::new(brtf_model::Shape::single(kind), true, false);
     assert_eq!(
         map.slots
             .iter()

@@ -11,6 +11,8 @@ use brtf_model::{MaterialKind, ModelError};
 fn plastic(method: Interpolation, rows: &[(f64, [f64; 5])]) -> ParamTable {
     ParamTable {
         kind: MaterialKind::Plastic,
+        lobes: 1,
+        oriented: false,
         orientation: [1.0, 0.0, 0.0],
         method,
         theta_in: rows.iter().map(|r| r.0).collect(),
@@ -312,6 +314,8 @@ fn a_lookup_that_is_no_valid_material_is_an_error() {
     // the interpolated material is no material.
     let table = ParamTable {
         kind: MaterialKind::Plastic2,
+        lobes: 1,
+        oriented: false,
         orientation: [1.0, 0.0, 0.0],
         method: Interpolation::Pchip,
         theta_in: vec![0.0, 60.0],
@@ -346,8 +350,13 @@ fn tables_from_reports_sort_rows_and_refuse_one_or_duplicate_incidences() {
     let kind = MaterialKind::Plastic;
     let at = |theta: f64, spec: f64| report(kind, theta, &[0.5, 0.5, 0.5, spec, 0.1], 1.0);
     let reports = [at(60.0, 0.09), at(0.0, 0.03), at(30.0, 0.05)];
-    let table =
-        ParamTable::from_reports(kind, [1.0, 0.0, 0.0], &reports, Interpolation::Linear).unwrap();
+    let table = ParamTable::from_reports(
+        brtf_model::Shape::single(kind),
+        [1.0, 0.0, 0.0],
+        &reports,
+        Interpolation::Linear,
+    )
+    .unwrap();
     assert_eq!(table.theta_in, vec![0.0, 30.0, 60.0]);
     assert_eq!(
         table.args.iter().map(|a| a[3]).collect::<Vec<_>>(),
@@ -355,27 +364,47 @@ fn tables_from_reports_sort_rows_and_refuse_one_or_duplicate_incidences() {
     );
     assert!((table.args_at(45.0).0[3] - 0.07).abs() < 1e-12);
     assert_eq!(
-        ParamTable::from_reports(kind, [1.0, 0.0, 0.0], &reports[..1], Interpolation::Pchip)
-            .unwrap_err(),
+        ParamTable::from_reports(
+            brtf_model::Shape::single(kind),
+            [1.0, 0.0, 0.0],
+            &reports[..1],
+            Interpolation::Pchip
+        )
+        .unwrap_err(),
         TableError::NeedTwoIncidences(1)
     );
     let twice = [at(30.0, 0.05), at(30.0, 0.06)];
     assert_eq!(
-        ParamTable::from_reports(kind, [1.0, 0.0, 0.0], &twice, Interpolation::Pchip).unwrap_err(),
+        ParamTable::from_reports(
+            brtf_model::Shape::single(kind),
+            [1.0, 0.0, 0.0],
+            &twice,
+            Interpolation::Pchip
+        )
+        .unwrap_err(),
         TableError::DuplicateTheta(30.0)
     );
     // Averaged over azimuths instead, the same two rows are one ring: the
     // mean of their arguments (and still too few for a table).
     let mut three = twice.to_vec();
     three.push(at(60.0, 0.10));
-    let averaged =
-        ParamTable::from_reports_phi_averaged(kind, [1.0, 0.0, 0.0], &three, Interpolation::Pchip)
-            .unwrap();
+    let averaged = ParamTable::from_reports_phi_averaged(
+        brtf_model::Shape::single(kind),
+        [1.0, 0.0, 0.0],
+        &three,
+        Interpolation::Pchip,
+    )
+    .unwrap();
     assert_eq!(averaged.theta_in, vec![30.0, 60.0]);
     assert!((averaged.args[0][3] - 0.055).abs() < 1e-12);
     assert_eq!(
-        ParamTable::from_reports_phi_averaged(kind, [1.0, 0.0, 0.0], &twice, Interpolation::Pchip)
-            .unwrap_err(),
+        ParamTable::from_reports_phi_averaged(
+            brtf_model::Shape::single(kind),
+            [1.0, 0.0, 0.0],
+            &twice,
+            Interpolation::Pchip
+        )
+        .unwrap_err(),
         TableError::NeedTwoIncidences(1)
     );
 }

@@ -184,6 +184,8 @@ mod tests {
         ParamTable {
             azimuth: None,
             kind: MaterialKind::Plastic,
+            lobes: 1,
+            oriented: false,
             orientation: [1.0, 0.0, 0.0],
             method,
             theta_in: vec![0.0, 15.0, 30.0, 50.0, 70.0],
