@@ -39,10 +39,10 @@ pub use error::WorkflowError;
 pub use folder::{FolderWritten, Outputs, save_fit, write_fit_folder};
 pub use info::describe_files;
 pub use inputs::{FitInputs, default_name, is_klems, sample_files};
-pub use material::{MaterialSource, RenderMaterial, load_render_material, read_material_file};
+pub use material::read_material_file;
 pub use render::{
-    GonioRequest, GonioRun, ImageRequest, ImageRun, render_gonio, render_image, with_extension,
-    write_synth_set,
+    GonioRequest, GonioRun, ImageRequest, ImageRun, MaterialSource, RenderMaterial,
+    load_render_material, render_gonio, render_image, with_extension, write_synth_set,
 };
 pub use run::{FitJob, FolderRequest, FolderRun, SampleOutcome, fit_samples, fit_to_folder};
 pub use settings::{FitSettings, MAX_PATCH_SAMPLES};
