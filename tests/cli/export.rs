@@ -176,6 +176,7 @@ fn result_of(
         table,
         interpolation: method,
         warnings: Vec::new(),
+        auto: None,
         outputs: Vec::new(),
     }
 }

@@ -5,6 +5,52 @@ use crate::problem::ResidualKind;
 use brtf_model::{EvalOptions, MaterialKind, Shape};
 use serde::{Deserialize, Serialize};
 
+/// The model asked for: one type, or `auto`, which fits a candidate set
+/// and keeps the one that earns its parameters ([`crate::AutoChoice`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ModelChoice {
+    /// This type (with `--lobes` and the orientation as given).
+    Fixed(MaterialKind),
+    /// Plastic or metal, the anisotropic type with its orientation
+    /// fitted, two lobes and two anisotropic lobes, chosen by held-out E1.
+    Auto,
+}
+
+impl brtf_model::OptionWords for ModelChoice {
+    const ALL: &'static [Self] = &[
+        ModelChoice::Fixed(MaterialKind::Plastic),
+        ModelChoice::Fixed(MaterialKind::Metal),
+        ModelChoice::Fixed(MaterialKind::Trans),
+        ModelChoice::Fixed(MaterialKind::Plastic2),
+        ModelChoice::Fixed(MaterialKind::Metal2),
+        ModelChoice::Fixed(MaterialKind::Trans2),
+        ModelChoice::Auto,
+    ];
+    const WORDS: &'static [&'static str] = &[
+        "plastic", "metal", "trans", "plastic2", "metal2", "trans2", "auto",
+    ];
+    const ALIASES: &'static [(&'static str, Self)] = &[];
+    fn word(self) -> &'static str {
+        match self {
+            ModelChoice::Fixed(kind) => kind.name(),
+            ModelChoice::Auto => "auto",
+        }
+    }
+}
+
+impl std::fmt::Display for ModelChoice {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(brtf_model::OptionWords::word(*self))
+    }
+}
+
+impl std::str::FromStr for ModelChoice {
+    type Err = brtf_model::WordError;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        brtf_model::parse_word(s)
+    }
+}
+
 /// Robust loss, applied by iteratively reweighting the residuals.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
 pub enum RobustLoss {

@@ -188,6 +188,22 @@ impl PatchPairs {
 }
 
 impl IncidenceData {
+    /// The same incidence with other samples (no patch pairs: measured
+    /// samples only).
+    pub(crate) fn with_samples(&self, samples: Vec<FitSample>) -> IncidenceData {
+        IncidenceData {
+            source: self.source.clone(),
+            theta_in: self.theta_in,
+            phi_in: self.phi_in,
+            channels: self.channels,
+            samples,
+            gates: self.gates.clone(),
+            weighting: self.weighting,
+            patch_pairs: None,
+            cosine_weighted: self.cosine_weighted,
+        }
+    }
+
     /// Unit vector towards the light.
     pub fn light(&self) -> DVec3 {
         brtf_model::direction(self.theta_in, self.phi_in)

@@ -495,6 +495,102 @@ fn same_basin(a: &Solved, b: &Solved) -> bool {
             .all(|(x, y)| (x - y).abs() <= 1e-2)
 }
 
+/// The held-out E1 of `report` on `data`: the samples are dealt into
+/// `folds` folds (by a hash of their index, so neighbours fall apart);
+/// each fold is fitted again without its samples, from `report`'s point
+/// (the final stage alone), and judged on them. Returns E1's numerator and
+/// denominator summed over the folds, so that incidences pool.
+pub(crate) fn heldout_e1_parts(
+    data: &IncidenceData,
+    config: &FitConfig,
+    report: &FitReport,
+    folds: usize,
+) -> Option<(f64, f64)> {
+    let fold_of = |i: usize| -> usize {
+        let mut rng = brtf_model::Rng::new(0x00c0_ffee, i as u64);
+        (rng.uniform() * folds as f64) as usize % folds
+    };
+    let parts: Vec<Option<(f64, f64)>> = (0..folds)
+        .into_par_iter()
+        .map(|fold| {
+            let split = |keep: bool| {
+                data.with_samples(
+                    data.samples
+                        .iter()
+                        .enumerate()
+                        .filter(|(i, _)| (fold_of(*i) == fold) != keep)
+                        .map(|(_, s)| *s)
+                        .collect(),
+                )
+            };
+            let (train, test) = (split(true), split(false));
+            if train.samples.is_empty() || test.samples.is_empty() {
+                return None;
+            }
+            let (args, scale) = refit(&train, config, report)?;
+            e1_parts(&test, config, &args, scale, report.floor)
+        })
+        .collect();
+    parts
+        .into_iter()
+        .try_fold((0.0, 0.0), |(m, t), p| p.map(|(a, b)| (m + a, t + b)))
+}
+
+/// The point the final stage reaches on `data` from `report`'s.
+fn refit(data: &IncidenceData, config: &FitConfig, report: &FitReport) -> Option<(Vec<f64>, f64)> {
+    let channels = data.channels.clamp(1, 3);
+    let gray = config.gray || channels == 1;
+    let map = ParamMap::new(config.shape(), gray, config.free_scale)
+        .with_min_roughness(config.min_roughness);
+    let mut scan = prepare::scan(data, channels, config).ok()?;
+    scan.block.set_factors(config.residual, report.floor);
+    let blocks = [scan.block];
+    let solver = Solver {
+        map: &map,
+        config,
+        orientation: DVec3::from_array(config.orientation),
+        channels,
+        floor: report.floor,
+    };
+    let u0 = unconstrained(&map, &report.material_args, report.scale);
+    let solved = solver.solve(&blocks, u0, Stage::FINAL);
+    if !solved.cost.is_finite() {
+        return None;
+    }
+    let p: Vec<f64> = (0..map.len())
+        .map(|i| map.to_physical(i, solved.u[i]).0)
+        .collect();
+    Some(map.material_args(&p))
+}
+
+/// E1's numerator and denominator of the material `args` (times `scale`)
+/// on `data`.
+pub(crate) fn e1_parts(
+    data: &IncidenceData,
+    config: &FitConfig,
+    args: &[f64],
+    scale: f64,
+    floor: f64,
+) -> Option<(f64, f64)> {
+    let channels = data.channels.clamp(1, 3);
+    let map = ParamMap::new(
+        config.shape(),
+        config.gray || channels == 1,
+        config.free_scale,
+    );
+    let scan = prepare::scan(data, channels, config).ok()?;
+    let blocks = [scan.block];
+    let solver = Solver {
+        map: &map,
+        config,
+        orientation: DVec3::from_array(config.orientation),
+        channels,
+        floor,
+    };
+    let u = unconstrained(&map, args, scale);
+    solver.problem(&blocks).e1_parts(&u)
+}
+
 /// The unconstrained point of physical flat arguments `args` and `scale`.
 fn unconstrained(map: &ParamMap, args: &[f64], scale: f64) -> DVector<f64> {
     DVector::from_iterator(

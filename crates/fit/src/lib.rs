@@ -30,6 +30,7 @@
 //! This is the only crate that uses nalgebra and levenberg-marquardt.
 
 mod adequacy;
+mod auto;
 mod config;
 mod data;
 mod diagnose;
@@ -59,8 +60,9 @@ mod validate;
 pub use adequacy::{
     Adequacy, ENERGY_TOLERANCE, PEAK_TOLERANCE_DEG, RESIDUAL_KIND_TOLERANCE, ResidualCheck,
 };
+pub use auto::{AutoChoice, CandidateRecord, FOLDS, MARGIN_POINTS, MARGIN_RELATIVE};
 pub use brtf_gonio::Gate;
-pub use config::{FitConfig, FitError, KnownReflectance, RobustLoss};
+pub use config::{FitConfig, FitError, KnownReflectance, ModelChoice, RobustLoss};
 pub use data::{FitSample, GateCount, IncidenceData, PatchPairs, Weighting};
 pub use fitter::{fit_global, fit_incidence};
 pub use params::{MAX_ROUGHNESS, MIN_ROUGHNESS, ParamMap, Slot, Target};

@@ -318,6 +318,13 @@ impl<'a> Problem<'a> {
     /// channel, ω the sample's weight, c its |cos θ_out| for cosine-weighted
     /// data (see [`crate::FitReport::e1`]); `None` when not finite.
     pub(crate) fn e1(&self, u: &DVector<f64>) -> Option<f64> {
+        let (misfit, total) = self.e1_parts(u)?;
+        let e1 = misfit / total;
+        e1.is_finite().then_some(e1)
+    }
+
+    /// E1's numerator and denominator at `u` (see [`Problem::e1`]).
+    pub(crate) fn e1_parts(&self, u: &DVector<f64>) -> Option<(f64, f64)> {
         let (kernel, chunks) = self.kernel(u)?;
         let (blocks, channels) = (self.blocks, self.channels);
         let sums = |&(b, start, end): &Chunk| -> (f64, f64) {
@@ -347,11 +354,11 @@ impl<'a> Problem<'a> {
         } else {
             chunks.iter().map(sums).collect()
         };
-        let (misfit, total) = parts
-            .iter()
-            .fold((0.0, 0.0), |(m, t), (a, b)| (m + a, t + b));
-        let e1 = misfit / total;
-        e1.is_finite().then_some(e1)
+        Some(
+            parts
+                .iter()
+                .fold((0.0, 0.0), |(m, t), (a, b)| (m + a, t + b)),
+        )
     }
 
     /// The cost ½‖r‖² at `u` (`None` when a residual is not finite), from

@@ -125,6 +125,9 @@ pub struct FitResult {
     /// Warnings about the whole set.
     #[serde(default)]
     pub warnings: Vec<SetWarning>,
+    /// `--model auto`: the candidates and why the fit's model won.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub auto: Option<crate::AutoChoice>,
     /// Every other file of the fit folder, with its SHA-256 and the step
     /// that wrote it (`docs/fit-json.md`, "Output files"). Empty until the
     /// folder is complete, and in folders written before the listing.

@@ -52,6 +52,9 @@ pub struct FitSetOptions {
     pub adequacy: bool,
     /// What to take from Klems BSDF XML inputs.
     pub klems: KlemsOptions,
+    /// `--model auto`: fit the candidate set and keep the winner
+    /// ([`crate::AutoChoice`]); `config`'s type is then ignored.
+    pub auto: bool,
 }
 
 impl FitSetOptions {
@@ -188,6 +191,23 @@ pub fn fit_set_with_data(
     // the second fits may still run.
     // What the fitter reads of each input, made once for both fits.
     let mut data = incidence_data(&inputs);
+    // `--model auto`: the candidates' fits decide the configuration.
+    let auto = if options.auto {
+        if recipe.patch_average.is_some() {
+            return Err(FitSetError::Fit(FitError::Failed {
+                origin: "--model auto".into(),
+                reason: "the candidates' lobe sums need gonio-photometer scans, not Klems \
+                         patch averages"
+                    .into(),
+            }));
+        }
+        let prepared: Vec<&PreparedMeasurement> = inputs.iter().map(|i| &i.prepared).collect();
+        let (chosen, record) = crate::auto::choose(&config, &prepared, &data)?;
+        config = chosen;
+        Some(record)
+    } else {
+        None
+    };
     // So is the geometry, which a rescale of the values leaves as it is.
     let geometry = shared_geometry(&data, &config)?;
     let (main, early) = rayon::join(
@@ -300,6 +320,7 @@ pub fn fit_set_with_data(
         table,
         interpolation: options.interpolation,
         warnings,
+        auto,
         outputs: Vec::new(),
     };
     Ok(FittedSet { result, prepared })

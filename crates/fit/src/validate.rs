@@ -73,6 +73,7 @@ mod tests {
             command_line: Vec::new(),
             adequacy: false,
             klems: Default::default(),
+            auto: false,
         }
     }
 

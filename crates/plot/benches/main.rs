@@ -57,6 +57,7 @@ fn fitted() -> &'static brtf_fit::FittedSet {
             command_line: vec!["bench".into()],
             adequacy: true,
             klems: Default::default(),
+            auto: false,
         };
         brtf_fit::fit_set_with_data(&[golden_path()], &options, &NoProgress).expect("the scan fits")
     })

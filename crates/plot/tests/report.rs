@@ -185,6 +185,7 @@ fn the_fits_own_data_draw_the_same_plots_as_the_files() {
         command_line: vec!["test".into()],
         adequacy: false,
         klems: Default::default(),
+        auto: false,
     };
     let mut files: Vec<_> = std::fs::read_dir(repo().join("data/alu-ggx"))
         .unwrap()

@@ -101,7 +101,7 @@ fn fit_set(
             })
             .transpose()?,
         patch_samples,
-        ..brtf_workflow::FitSettings::new(word("model", model)?)
+        ..brtf_workflow::FitSettings::new(word::<brtf_fit::ModelChoice>("model", model)?)
     };
     fit::run_fit(py, inputs, settings, name, jobs)
 }

@@ -109,6 +109,7 @@ fn fit(
         incidences,
         table,
         interpolation: Interpolation::Pchip,
+        auto: None,
         warnings: Vec::new(),
         outputs: Vec::new(),
     }

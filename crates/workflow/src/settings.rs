@@ -4,8 +4,8 @@
 use crate::WorkflowError;
 use brtf_fit::klems::IncidenceFilter;
 use brtf_fit::{
-    ColourConversion, FitConfig, FitSetOptions, Interpolation, KnownReflectance, Recipe,
-    ResidualKind, RobustLoss, ScaleRule, SelectionOptions, WeightRule,
+    ColourConversion, FitConfig, FitSetOptions, Interpolation, KnownReflectance, ModelChoice,
+    Recipe, ResidualKind, RobustLoss, ScaleRule, SelectionOptions, WeightRule,
 };
 use brtf_gonio::Hemispheres;
 use brtf_gonio::klems::Sides;
@@ -17,8 +17,8 @@ pub const MAX_PATCH_SAMPLES: usize = 4096;
 /// Every fit option of `brtf fit` and `brtf.fit`, with their defaults.
 #[derive(Debug, Clone)]
 pub struct FitSettings {
-    /// The model fitted.
-    pub model: MaterialKind,
+    /// The model fitted: one type, or `auto` (a candidate set).
+    pub model: ModelChoice,
     /// Tie R = G = B.
     pub gray: bool,
     /// Formula set.
@@ -74,7 +74,7 @@ pub struct FitSettings {
 
 impl FitSettings {
     /// The defaults for fitting `model`.
-    pub fn new(model: MaterialKind) -> FitSettings {
+    pub fn new(model: ModelChoice) -> FitSettings {
         FitSettings {
             model,
             gray: false,
@@ -123,9 +123,19 @@ impl FitSettings {
                 "--patch-samples must be between 1 and {MAX_PATCH_SAMPLES}"
             )));
         }
+        // `auto` fits plastic and metal families; its options are plastic's.
+        let (kind, auto) = match self.model {
+            ModelChoice::Fixed(kind) => (kind, false),
+            ModelChoice::Auto => (MaterialKind::Plastic, true),
+        };
+        if auto && self.lobes != 1 {
+            return Err(WorkflowError::Usage(
+                "--model auto chooses the lobes itself: leave out --lobes".into(),
+            ));
+        }
         let hemisphere = match self.hemisphere {
             Some(h) => h.only(),
-            None => SelectionOptions::default_hemisphere(self.model),
+            None => SelectionOptions::default_hemisphere(kind),
         };
         let selections = SelectionOptions {
             hemisphere,
@@ -135,15 +145,18 @@ impl FitSettings {
             mask_holder: self.mask_holder,
         }
         .gates(klems);
-        let mut config = FitConfig::new(self.model);
+        let mut config = FitConfig::new(kind);
         config.options.variant = self.variant;
         config.options.fresnel_k = self.fresnel_k;
         config.options.source_omega = self.source_omega;
         config.orientation = self.orientation.unwrap_or([1.0, 0.0, 0.0]);
-        config.oriented = self.model.is_anisotropic() && !klems && self.orientation.is_none();
+        // Auto's anisotropic candidates fit their orientation unless one is given.
+        config.oriented = (auto || kind.is_anisotropic()) && !klems && self.orientation.is_none();
         config.lobes = self.lobes;
-        brtf_model::Shape::new(self.model, self.lobes, config.oriented)
-            .map_err(WorkflowError::Usage)?;
+        if !auto {
+            brtf_model::Shape::new(kind, self.lobes, config.oriented)
+                .map_err(WorkflowError::Usage)?;
+        }
         config.gray = self.gray;
         config.free_scale = self.free_scale;
         config.residual = self.residual;
@@ -171,6 +184,7 @@ impl FitSettings {
                 side: None,
                 incidences: self.incidences.clone(),
             },
+            auto,
         };
         let options = if klems {
             options.for_klems(self.patch_samples)

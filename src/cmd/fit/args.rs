@@ -3,10 +3,11 @@
 use crate::cmd::material::FormulaArgs;
 use crate::cmd::shared::words;
 use brtf_fit::klems::IncidenceFilter;
-use brtf_fit::{ColourConversion, Interpolation, KnownReflectance, ResidualKind, RobustLoss};
+use brtf_fit::{
+    ColourConversion, Interpolation, KnownReflectance, ModelChoice, ResidualKind, RobustLoss,
+};
 use brtf_fit::{WeightRule, en14501::En14501};
 use brtf_gonio::{Hemispheres, klems::Sides};
-use brtf_model::MaterialKind;
 use brtf_workflow::{FitSettings, Outputs};
 use clap::Args;
 use std::path::PathBuf;
@@ -19,9 +20,11 @@ pub(crate) struct FitArgs {
     /// .txt files), each fitted into OUT/<name>/.
     #[arg(required_unless_present = "en14501")]
     pub files: Vec<PathBuf>,
-    /// Model to fit.
-    #[arg(long, required_unless_present = "en14501", value_parser = words::<MaterialKind>())]
-    pub model: Option<MaterialKind>,
+    /// Model to fit; `auto` fits plastic or metal, its anisotropic type,
+    /// two lobes and two anisotropic lobes, and keeps the one with the best
+    /// held-out E1 that earns its parameters.
+    #[arg(long, required_unless_present = "en14501", value_parser = words::<ModelChoice>())]
+    pub model: Option<ModelChoice>,
     /// No files: a grey roughness-0 `trans` from datasheet values at normal
     /// incidence (EN 14501), `tau_nh=…,tau_nn=…,rho_nh=…[,spec=…]`, printed
     /// as a Radiance material (docs/fitting.md, "EN 14501 shortcut").
