@@ -63,8 +63,12 @@ pub struct CandidateRecord {
 /// What `--model auto` tried and why it chose what it chose.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct AutoChoice {
-    /// Every candidate, the family's one-lobe rival first.
+    /// Every candidate, after the other family's one-lobe fit when both
+    /// families were tried (`first` is the first candidate's index).
     pub candidates: Vec<CandidateRecord>,
+    /// Index of the first candidate in `candidates` (1 when the other
+    /// family's one-lobe fit comes first, else 0).
+    pub first: usize,
     /// Index of the winner in `candidates`.
     pub chosen: usize,
     /// Why, for people.
@@ -92,21 +96,28 @@ fn candidate_configs(base: &FitConfig, kind: MaterialKind, oriented: bool) -> Ve
 /// A candidate's fits: every incidence, and its record.
 struct Candidate {
     config: FitConfig,
+    reports: Vec<FitReport>,
     record: CandidateRecord,
 }
 
-/// Fits `config` to every incidence and judges it.
+/// Fits `config` to every incidence (a lobe sum from the one-lobe fits
+/// `base`) and judges it.
 fn judge(
     config: FitConfig,
     prepared: &[&PreparedMeasurement],
     data: &[IncidenceData],
+    base: Option<&[FitReport]>,
 ) -> Result<Candidate, FitSetError> {
     let started = Instant::now();
     let geometry: Vec<SharedGeometry> = shared_geometry(data, &config)?;
     let reports: Vec<FitReport> = data
         .par_iter()
         .zip(&geometry)
-        .map(|(d, g)| crate::fitter::fit_incidence_sharing(d, &config, g))
+        .enumerate()
+        .map(|(k, (d, g))| match base {
+            Some(base) => crate::fitter::fit_incidence_from(d, &config, g, &base[k]),
+            None => crate::fitter::fit_incidence_sharing(d, &config, g),
+        })
         .collect::<Result<_, _>>()?;
     let pooled = |parts: Vec<Option<(f64, f64)>>| -> f64 {
         let (m, t) = parts
@@ -154,7 +165,11 @@ fn judge(
         collapsed,
         elapsed_ms: started.elapsed().as_secs_f64() * 1e3,
     };
-    Ok(Candidate { config, record })
+    Ok(Candidate {
+        config,
+        reports,
+        record,
+    })
 }
 
 /// Runs the candidate set on `data` (prepared as `prepared`) and returns
@@ -164,47 +179,61 @@ pub(crate) fn choose(
     prepared: &[&PreparedMeasurement],
     data: &[IncidenceData],
 ) -> Result<(FitConfig, AutoChoice), FitSetError> {
-    // The family: plastic or metal, by the one-lobe fits' cost.
+    // The family: plastic or metal, by the one-lobe fits' cost. Under a
+    // free scale the colour is held at 1, where metal is plastic: plastic.
     let one = |kind| FitConfig {
         kind,
         lobes: 1,
         oriented: false,
         ..base.clone()
     };
-    let (plastic, metal) = rayon::join(
-        || judge(one(MaterialKind::Plastic), prepared, data),
-        || judge(one(MaterialKind::Metal), prepared, data),
-    );
-    let (plastic, metal) = (plastic?, metal?);
-    let metal_wins = metal.record.cost < plastic.record.cost * (1.0 - 1e-9);
-    let (family, rival) = if metal_wins {
-        (metal, plastic)
+    let mut candidates = Vec::new();
+    let family = if base.free_scale {
+        judge(one(MaterialKind::Plastic), prepared, data, None)?
     } else {
-        (plastic, metal)
+        let (plastic, metal) = rayon::join(
+            || judge(one(MaterialKind::Plastic), prepared, data, None),
+            || judge(one(MaterialKind::Metal), prepared, data, None),
+        );
+        let (plastic, metal) = (plastic?, metal?);
+        let metal_wins = metal.record.cost < plastic.record.cost * (1.0 - 1e-9);
+        let (family, rival) = if metal_wins {
+            (metal, plastic)
+        } else {
+            (plastic, metal)
+        };
+        candidates.push(rival);
+        family
     };
+    let first = candidates.len();
     let configs = candidate_configs(base, family.config.kind, base.oriented);
-    let mut candidates = vec![rival, family];
-    for config in configs.into_iter().skip(1) {
-        candidates.push(judge(config, prepared, data)?);
+    candidates.push(family);
+    for (i, config) in configs.into_iter().enumerate().skip(1) {
+        // Two lobes start from the candidate of one lobe of their type.
+        let base = (config.lobes > 1).then(|| candidates[first + i - 2].reports.as_slice());
+        let judged = judge(config, prepared, data, base)?;
+        candidates.push(judged);
     }
     let records: Vec<CandidateRecord> = candidates.iter().map(|c| c.record.clone()).collect();
-    let chosen = pick(&records);
-    let reason = explain(&records, chosen);
+    let chosen = pick(&records, first);
+    let reason = explain(&records, chosen, first);
     let config = candidates.swap_remove(chosen).config;
     Ok((
         config,
         AutoChoice {
             candidates: records,
+            first,
             chosen,
             reason,
         },
     ))
 }
 
-/// The winner among `records` (see the module docs); the rival family's
-/// one-lobe fit (index 0) is a reference, not a candidate.
-fn pick(records: &[CandidateRecord]) -> usize {
-    let eligible: Vec<usize> = (1..records.len())
+/// The winner among `records` from index `first` on (see the module
+/// docs); the rival family's one-lobe fit before it, if any, is a
+/// reference, not a candidate.
+fn pick(records: &[CandidateRecord], first: usize) -> usize {
+    let eligible: Vec<usize> = (first..records.len())
         .filter(|&i| !records[i].collapsed && records[i].e1_heldout.is_finite())
         .collect();
     let Some(best) = eligible
@@ -212,7 +241,7 @@ fn pick(records: &[CandidateRecord]) -> usize {
         .map(|&i| records[i].e1_heldout)
         .reduce(f64::min)
     else {
-        return 1;
+        return first;
     };
     let good_enough = best + (MARGIN_POINTS).max(MARGIN_RELATIVE * best);
     eligible
@@ -224,11 +253,11 @@ fn pick(records: &[CandidateRecord]) -> usize {
                 .cmp(&records[b].parameters)
                 .then(records[a].e1_heldout.total_cmp(&records[b].e1_heldout))
         })
-        .unwrap_or(1)
+        .unwrap_or(first)
 }
 
 /// Why `chosen` won, for people.
-fn explain(records: &[CandidateRecord], chosen: usize) -> String {
+fn explain(records: &[CandidateRecord], chosen: usize, first: usize) -> String {
     let c = &records[chosen];
     let pct = |x: f64| format!("{:.1}%", 100.0 * x);
     let mut text = format!(
@@ -237,7 +266,7 @@ fn explain(records: &[CandidateRecord], chosen: usize) -> String {
         pct(c.e1_heldout),
         c.parameters
     );
-    let mut simpler: Vec<&CandidateRecord> = records[1..]
+    let mut simpler: Vec<&CandidateRecord> = records[first..]
         .iter()
         .filter(|r| r.parameters < c.parameters)
         .collect();
@@ -249,7 +278,7 @@ fn explain(records: &[CandidateRecord], chosen: usize) -> String {
             pct(s.e1_heldout)
         );
     }
-    let richer: Vec<String> = records[1..]
+    let richer: Vec<String> = records[first..]
         .iter()
         .filter(|r| r.parameters > c.parameters)
         .map(|r| {
@@ -305,14 +334,18 @@ mod tests {
             record("plastic2 ×2", 8, 0.125, false),
         ];
         // 0.125 is best; 0.128 is within 0.5 points of it: the simpler wins.
-        assert_eq!(pick(&records), 3);
+        assert_eq!(pick(&records, 1), 3);
         let mut clear = records.clone();
         clear[4].e1_heldout = 0.06;
-        assert_eq!(pick(&clear), 4);
+        assert_eq!(pick(&clear, 1), 4);
         // A collapsed candidate never wins.
         clear[4].collapsed = true;
-        assert_eq!(pick(&clear), 3);
-        let text = explain(&records, 3);
+        assert_eq!(pick(&clear, 1), 3);
+        // The rival family's record (index 0) is not a candidate.
+        let mut rival = records.clone();
+        rival[0].e1_heldout = 0.01;
+        assert_eq!(pick(&rival, 1), 3);
+        let text = explain(&records, 3, 1);
         assert!(
             text.starts_with("plastic ×2: held-out E1 12.8% with 5 parameters"),
             "{text}"

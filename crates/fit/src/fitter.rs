@@ -50,13 +50,13 @@ const IRLS_MAX_ROUNDS: usize = 100;
 
 /// Fits one incidence.
 pub fn fit_incidence(data: &IncidenceData, config: &FitConfig) -> Result<FitReport, FitError> {
-    fit_many(std::slice::from_ref(data), config, &data.source, None)
+    fit_many(std::slice::from_ref(data), config, &data.source, None, None)
 }
 
 /// Fits one parameter set to all incidences at once. Each incidence gets
 /// the same total weight, so densely sampled files do not dominate.
 pub fn fit_global(data: &[IncidenceData], config: &FitConfig) -> Result<FitReport, FitError> {
-    fit_many(data, config, "all incidences", None)
+    fit_many(data, config, "all incidences", None, None)
 }
 
 /// The argument-free geometry of one incidence's block, computed once and
@@ -111,6 +111,7 @@ pub(crate) fn fit_incidence_sharing(
         config,
         &data.source,
         Some(std::slice::from_ref(geometry)),
+        None,
     )
 }
 
@@ -120,14 +121,34 @@ pub(crate) fn fit_global_sharing(
     config: &FitConfig,
     geometry: &[SharedGeometry],
 ) -> Result<FitReport, FitError> {
-    fit_many(data, config, "all incidences", Some(geometry))
+    fit_many(data, config, "all incidences", Some(geometry), None)
 }
 
+/// [`fit_incidence_sharing`] of a lobe sum from its one-lobe fit `base`,
+/// made already.
+pub(crate) fn fit_incidence_from(
+    data: &IncidenceData,
+    config: &FitConfig,
+    geometry: &SharedGeometry,
+    base: &FitReport,
+) -> Result<FitReport, FitError> {
+    fit_many(
+        std::slice::from_ref(data),
+        config,
+        &data.source,
+        Some(std::slice::from_ref(geometry)),
+        Some(base),
+    )
+}
+
+/// The fit of `data` (one incidence, or all at once as `label`); a lobe
+/// sum starts from its one-lobe fit, `base` when given.
 fn fit_many(
     data: &[IncidenceData],
     config: &FitConfig,
     label: &str,
     geometry: Option<&[SharedGeometry]>,
+    base: Option<&FitReport>,
 ) -> Result<FitReport, FitError> {
     let started = Instant::now();
     let channels = data[0].channels.clamp(1, 3);
@@ -148,14 +169,16 @@ fn fit_many(
         ParamMap::new(shape, gray, config.free_scale).with_min_roughness(config.min_roughness);
     // A lobe sum starts from the one-lobe fit (and its split variations):
     // it can then only end at a cost at or below it.
-    let base = if shape.lobes > 1 {
-        let one = FitConfig {
-            lobes: 1,
-            ..config.clone()
-        };
-        Some(fit_many(data, &one, label, geometry)?)
-    } else {
-        None
+    let base = match (shape.lobes > 1, base) {
+        (false, _) => None,
+        (true, Some(base)) => Some(base.clone()),
+        (true, None) => {
+            let one = FitConfig {
+                lobes: 1,
+                ..config.clone()
+            };
+            Some(fit_many(data, &one, label, geometry, None)?)
+        }
     };
     // The blocks' geometry once per fit, or the fit set's shared one.
     let own_geometry = match geometry {
@@ -553,7 +576,7 @@ fn refit(data: &IncidenceData, config: &FitConfig, report: &FitReport) -> Option
         floor: report.floor,
     };
     let u0 = unconstrained(&map, &report.material_args, report.scale);
-    let solved = solver.solve(&blocks, u0, Stage::FINAL);
+    let solved = solver.solve(&blocks, u0, Stage::REFIT);
     if !solved.cost.is_finite() {
         return None;
     }

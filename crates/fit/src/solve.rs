@@ -50,6 +50,16 @@ impl Stage {
         tolerance: 1e-3,
         ..Stage::START
     };
+    /// A fit from a point near its minimum (the held-out folds of
+    /// `--model auto`, from the fit on every sample): a few passes to a
+    /// relative change of 1e-6.
+    pub(crate) const REFIT: Stage = Stage {
+        tolerance: 1e-6,
+        gtol: 1e-8,
+        patience: 10,
+        report: false,
+        secant: false,
+    };
     /// The fit on every sample, with the secant term in its Hessian
     /// (golden_paper: 6 passes from the polished start, 7 for the log
     /// fit); the gradient test stops it where ftol alone would spend a
