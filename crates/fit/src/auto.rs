@@ -173,12 +173,13 @@ fn judge(
 }
 
 /// Runs the candidate set on `data` (prepared as `prepared`) and returns
-/// the chosen configuration with the record of the choice.
+/// the chosen configuration, the record of the choice and the winner's
+/// fit of every incidence.
 pub(crate) fn choose(
     base: &FitConfig,
     prepared: &[&PreparedMeasurement],
     data: &[IncidenceData],
-) -> Result<(FitConfig, AutoChoice), FitSetError> {
+) -> Result<(FitConfig, AutoChoice, Vec<FitReport>), FitSetError> {
     // The family: plastic or metal, by the one-lobe fits' cost. Under a
     // free scale the colour is held at 1, where metal is plastic: plastic.
     let one = |kind| FitConfig {
@@ -217,15 +218,16 @@ pub(crate) fn choose(
     let records: Vec<CandidateRecord> = candidates.iter().map(|c| c.record.clone()).collect();
     let chosen = pick(&records, first);
     let reason = explain(&records, chosen, first);
-    let config = candidates.swap_remove(chosen).config;
+    let winner = candidates.swap_remove(chosen);
     Ok((
-        config,
+        winner.config,
         AutoChoice {
             candidates: records,
             first,
             chosen,
             reason,
         },
+        winner.reports,
     ))
 }
 

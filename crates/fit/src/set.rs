@@ -202,17 +202,32 @@ pub fn fit_set_with_data(
             }));
         }
         let prepared: Vec<&PreparedMeasurement> = inputs.iter().map(|i| &i.prepared).collect();
-        let (chosen, record) = crate::auto::choose(&config, &prepared, &data)?;
+        let (chosen, record, reports) = crate::auto::choose(&config, &prepared, &data)?;
         config = chosen;
-        Some(record)
+        Some((record, reports))
     } else {
         None
+    };
+    let (auto, chosen_reports) = match auto {
+        Some((record, reports)) => (Some(record), Some(reports)),
+        None => (None, None),
     };
     // So is the geometry, which a rescale of the values leaves as it is.
     let geometry = shared_geometry(&data, &config)?;
     let (main, early) = rayon::join(
         || {
-            let (reports, global) = fit_all(&data, &geometry, &config, progress)?;
+            let (reports, global) = match chosen_reports {
+                // The winner's fits are made: the all-incidence fit remains.
+                Some(reports) => {
+                    for _ in 0..reports.len() {
+                        progress.advance();
+                    }
+                    let global = global_fit(&data, &geometry, &config, &reports)?;
+                    progress.advance();
+                    (reports, global)
+                }
+                None => fit_all(&data, &geometry, &config, progress)?,
+            };
             let adequacy = other_early.then(|| diagnose_all(&inputs, &data, &reports, &config));
             Ok::<_, FitSetError>((reports, global, adequacy))
         },
@@ -548,4 +563,21 @@ fn fit_all(
         },
     };
     Ok((reports, global))
+}
+
+/// The all-incidence fit beside per-incidence `reports` made already
+/// (with one incidence, that incidence's fit).
+fn global_fit(
+    data: &[IncidenceData],
+    geometry: &[SharedGeometry],
+    config: &FitConfig,
+    reports: &[FitReport],
+) -> Result<FitReport, FitSetError> {
+    if data.len() < 2 {
+        return Ok(FitReport {
+            source: "all incidences".into(),
+            ..reports[0].clone()
+        });
+    }
+    Ok(fit_global_sharing(data, config, geometry)?)
 }
