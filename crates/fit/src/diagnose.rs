@@ -259,7 +259,14 @@ pub(crate) fn compare(
         .zip(&other.params)
         .filter(|(a, _)| !a.fixed && a.name != "scale")
         .map(|(a, b)| {
-            let change = (a.value - b.value).abs() / a.value.abs().max(b.value.abs()).max(0.02);
+            // The orientation is an angle modulo 180°: its change is the
+            // turn between the two, as a fraction of the largest (90°).
+            let change = if a.name == "orient" {
+                let turn = (a.value - b.value).rem_euclid(180.0);
+                turn.min(180.0 - turn) / 90.0
+            } else {
+                (a.value - b.value).abs() / a.value.abs().max(b.value.abs()).max(0.02)
+            };
             ResidualCheck {
                 residual,
                 param: a.name.clone(),

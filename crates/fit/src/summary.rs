@@ -77,6 +77,7 @@ pub fn summary(result: &FitResult, out: &Path) -> String {
         line("all".into(), g);
     }
     let _ = writeln!(s, "(! = at a bound, = = held fixed)");
+    auto_table(&mut s, result);
     adequacy_table(&mut s, result);
     let global = result.global.iter().filter(|_| result.incidences.len() > 1);
     let labelled = result
@@ -222,6 +223,48 @@ fn warning_kind(w: &crate::FitWarning) -> String {
             check.param, check.residual
         ),
     }
+}
+
+/// `--model auto`'s candidates and its choice.
+fn auto_table(s: &mut String, result: &FitResult) {
+    let Some(auto) = &result.auto else {
+        return;
+    };
+    let _ = writeln!(
+        s,
+        "\n--model auto: {} folds for the held-out E1 (* = chosen, – = not a candidate):",
+        crate::FOLDS
+    );
+    let _ = writeln!(
+        s,
+        "  {:<40} {:>6} {:>7} {:>9} {:>6} {:>10} {:>7}",
+        "model", "params", "E1", "held-out", "peak°", "cost", "ms"
+    );
+    for (i, c) in auto.candidates.iter().enumerate() {
+        let mark = if i == auto.chosen {
+            "*"
+        } else if i < auto.first {
+            "–"
+        } else {
+            " "
+        };
+        let peak = c
+            .peak_offset_deg
+            .map_or_else(|| "–".to_string(), |p| format!("{p:.1}"));
+        let collapsed = if c.collapsed { "  (collapsed)" } else { "" };
+        let _ = writeln!(
+            s,
+            "{mark} {:<40} {:>6} {:>6.1}% {:>8.1}% {:>6} {:>10.4e} {:>7.0}{collapsed}",
+            c.model,
+            c.parameters,
+            100.0 * c.e1,
+            100.0 * c.e1_heldout,
+            peak,
+            c.cost,
+            c.elapsed_ms
+        );
+    }
+    let _ = writeln!(s, "  chosen: {}", auto.reason);
 }
 
 /// The adequacy diagnostics, one line per incidence that has them.
