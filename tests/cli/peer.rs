@@ -1,6 +1,7 @@
 //! brtf's fitter against scipy's `least_squares` on the same objective:
 //! both real pgII scans, a grey metal with a free scale, with absolute,
-//! relative and log residuals and with a Huber loss. brtf's cost (by
+//! relative and log residuals and with a Huber loss, and a two-lobe metal
+//! (scipy from six starts). brtf's cost (by
 //! scipy's own cost function) must never be above scipy's, and the Huber
 //! fit, iterated until its weights settle, must match scipy's
 //! `loss="huber"` within 1% in cost.
@@ -65,24 +66,40 @@ fn brtf_is_never_above_scipy_on_the_same_objective() {
             );
         }
         std::fs::write(&csv, text).unwrap();
-        for (label, residual, loss) in [
-            ("absolute", ResidualKind::Absolute, RobustLoss::None),
-            ("relative", ResidualKind::Relative, RobustLoss::None),
-            ("log", ResidualKind::Log, RobustLoss::None),
-            ("absolute", ResidualKind::Absolute, RobustLoss::Huber(1.345)),
+        for (label, residual, loss, lobes) in [
+            ("absolute", ResidualKind::Absolute, RobustLoss::None, 1),
+            ("relative", ResidualKind::Relative, RobustLoss::None, 1),
+            ("log", ResidualKind::Log, RobustLoss::None, 1),
+            (
+                "absolute",
+                ResidualKind::Absolute,
+                RobustLoss::Huber(1.345),
+                1,
+            ),
+            ("absolute", ResidualKind::Absolute, RobustLoss::None, 2),
         ] {
             let mut config = FitConfig::new(MaterialKind::Metal);
             config.gray = true;
             config.free_scale = true;
             config.residual = residual;
             config.loss = loss;
+            config.lobes = lobes;
             let report = fit_incidence(&data, &config).unwrap();
             let value = |name: &str| report.value(name).unwrap();
+            let params: Vec<f64> = if lobes == 2 {
+                ["scale", "spec", "split1", "rough1", "rough2"]
+                    .iter()
+                    .map(|n| value(n))
+                    .collect()
+            } else {
+                vec![value("scale"), value("spec"), value("rough")]
+            };
             let mut settings = serde_json::json!({
                 "light": data.light().to_array(),
                 "floor": report.floor,
                 "residual": label,
-                "brtf": [value("scale"), value("spec"), value("rough")],
+                "lobes": lobes,
+                "brtf": params,
             });
             if let RobustLoss::Huber(c) = loss {
                 let robust = report.robust.expect("a robust record");
@@ -103,7 +120,7 @@ fn brtf_is_never_above_scipy_on_the_same_objective() {
             let scipy = answer["cost_scipy"].as_f64().unwrap();
             let brtf = answer["cost_at_brtf"].as_f64().unwrap();
             eprintln!(
-                "{scan} {label} {loss:?}: brtf {brtf:.9e} (own {:.9e}), scipy {scipy:.9e} {}",
+                "{scan} {label} {loss:?} {lobes} lobe(s): brtf {brtf:.9e} (own {:.9e}), scipy {scipy:.9e} {}",
                 report.cost, answer["params_scipy"]
             );
             if loss == RobustLoss::None {
