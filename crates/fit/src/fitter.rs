@@ -968,13 +968,8 @@ impl Reported<'_> {
         {
             warnings.push(FitWarning::RobustNotSettled { rounds: r.rounds });
         }
-        let successful = termination.was_successful();
         let termination = Termination::from_lm(&termination);
-        if !successful {
-            warnings.push(FitWarning::NotConverged {
-                termination: termination.clone(),
-            });
-        }
+        warnings.extend(FitWarning::not_converged(&termination));
 
         let single = self.data.len() == 1;
         let first = &self.data[0];

@@ -51,6 +51,8 @@ impl Termination {
     }
 
     /// The optimiser reached a stationary point (not a judgement of physics).
+    /// `NoImprovementPossible` counts: no step could lower the cost by more
+    /// than rounding, which is a stationary point to machine precision.
     pub fn converged(&self) -> bool {
         matches!(
             self,
@@ -287,6 +289,16 @@ pub enum FitWarning {
         /// Its share of the specularity, or the roughnesses' relative difference.
         value: f64,
     },
+}
+
+impl FitWarning {
+    /// The warning for a stop that met no convergence test, judged by
+    /// [`Termination::converged`] (the one test every reader uses).
+    pub(crate) fn not_converged(termination: &Termination) -> Option<FitWarning> {
+        (!termination.converged()).then(|| FitWarning::NotConverged {
+            termination: termination.clone(),
+        })
+    }
 }
 
 impl std::fmt::Display for FitWarning {
