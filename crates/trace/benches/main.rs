@@ -17,7 +17,7 @@
 //! (rtrace traces the same ones).
 
 use brtf_model::Rng;
-use brtf_model::{EvalOptions, Material, MaterialKind};
+use brtf_model::{Composite, EvalOptions, Material, MaterialKind};
 use brtf_trace::GonioSetup;
 use brtf_trace::RayCounts;
 use brtf_trace::{Camera, ImageOptions, Scene, Settings, Shader, Shape, Source, VirtualGonio};
@@ -34,10 +34,15 @@ fn plastic() -> Material {
     Material::new(MaterialKind::Plastic, &[0.5, 0.5, 0.5, 0.05, 0.1], None).unwrap()
 }
 
+/// The shader of one primitive.
+fn shader_of(material: &Material, options: &EvalOptions) -> Shader {
+    Shader::new(&Composite::from_material(material), options).unwrap()
+}
+
 /// The comparison scene (also written as Radiance text below).
 fn scene() -> Scene {
     let mut scene = Scene::new();
-    let id = scene.add_shader(Shader::new(&plastic(), &EvalOptions::default()));
+    let id = scene.add_shader(shader_of(&plastic(), &EvalOptions::default()));
     scene.add(
         Shape::Disk {
             center: DVec3::ZERO,
@@ -76,7 +81,7 @@ fn camera(width: usize, height: usize) -> Camera {
 
 fn bench_shading(c: &mut Criterion) {
     let options = EvalOptions::default();
-    let shader = Shader::new(&plastic(), &options);
+    let shader = shader_of(&plastic(), &options);
     let mut rng = Rng::new(1, 1);
     let dirs: Vec<(DVec3, DVec3)> = (0..1024)
         .map(|_| {
@@ -142,7 +147,7 @@ fn bench_gonio(c: &mut Criterion) {
         samples: 256,
         seed: 1,
     };
-    let gonio = VirtualGonio::new(Shader::new(&plastic(), &options), setup);
+    let gonio = VirtualGonio::new(shader_of(&plastic(), &options), setup);
     let v = brtf_model::direction(30.0, 180.0);
     let mut g = c.benchmark_group("gonio");
     g.throughput(Throughput::Elements(256));

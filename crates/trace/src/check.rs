@@ -13,6 +13,11 @@
 //!   widening); differences show what the formula's approximations cost;
 //! * the fit's own **model vs measured** RMS, for reference.
 //!
+//! The fit may be of any shape: one primitive, a lobe sum (the model is
+//! brtf-model's `CompositeBsdf`, the render the [`Shader`] of the lobes)
+//! or an anisotropic type with its orientation fitted (the frame turns
+//! with θ_in as the table's `orient` does).
+//!
 //! Differences are relative with the fit's floor, `(a − b)/sqrt(b² + floor²)`,
 //! the same measure as the fit's `rms_rel`. Between fitted incidences it
 //! renders intermediate θ_in (the θ_in table's interpolation) at the lower
@@ -21,7 +26,7 @@
 use crate::Shader;
 use crate::gonio::{GonioSetup, VirtualGonio};
 use brtf_fit::{FitReport, FitResult, Gate};
-use brtf_model::{Bsdf, Material, Rgb};
+use brtf_model::{Composite, CompositeBsdf, Rgb};
 use glam::DVec3;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -164,8 +169,8 @@ pub struct CheckRow {
 pub struct CheckReport {
     /// The fit's name and model.
     pub name: String,
-    /// `plastic`, `metal`...
-    pub kind: brtf_model::MaterialKind,
+    /// The fitted shape: `metal`, `metal ×2 lobes`, `metal2 (orientation fitted)`...
+    pub shape: brtf_model::Shape,
     /// The θ_in table was rendered (else the static material).
     pub table: bool,
     /// One row per fitted and intermediate incidence, by θ_in.
@@ -210,11 +215,11 @@ pub fn check_fit(
     let shader = match &fit.table {
         Some(table) => Shader::from_table(table, &eval_options)?,
         None => Shader::new(
-            &fit.static_material().ok_or(CheckError::NoMaterial)?,
+            &fit.static_composite().ok_or(CheckError::NoMaterial)?,
             &eval_options,
-        ),
+        )?,
     };
-    let render = |material: &Material, d: &Directions, kind: RowKind| {
+    let render = |material: &Composite, d: &Directions, kind: RowKind| {
         let setup = GonioSetup {
             theta_in: d.theta_in,
             phi_in: d.phi_in,
@@ -230,7 +235,7 @@ pub fn check_fit(
     for (index, report) in fit.incidences.iter().enumerate() {
         let directions = fitted_directions(fit, index, dir, options)?;
         let material = fit
-            .material_at_direction(report.theta_in, report.phi_in, Some(report))
+            .composite_at_direction(report.theta_in, report.phi_in, Some(report))
             .ok_or(CheckError::NoMaterial)?;
         let mut row = render(&material, &directions, RowKind::Fitted);
         row.fit_rms = Some(report.rms_rel);
@@ -247,7 +252,7 @@ pub fn check_fit(
                 let t = lo.theta_in
                     + (hi.theta_in - lo.theta_in) * k as f64 / (options.intermediate + 1) as f64;
                 let material = fit
-                    .material_at_direction(t, lo.phi_in, None)
+                    .composite_at_direction(t, lo.phi_in, None)
                     .ok_or(CheckError::NoMaterial)?;
                 // The neighbour's directions, minus those near this beam.
                 let between = Directions {
@@ -267,7 +272,7 @@ pub fn check_fit(
     }
     Ok(CheckReport {
         name: fit.name.clone(),
-        kind: fit.config.kind,
+        shape: fit.config.shape(),
         table: fit.table.is_some(),
         rows,
         source_omega,
@@ -393,7 +398,7 @@ fn mask_beam(mut d: Directions, half_angle_deg: f64) -> Directions {
 #[allow(clippy::needless_range_loop)] // channel loops index several arrays at once
 fn compare(
     shader: &Shader,
-    material: &Material,
+    material: &Composite,
     fit: &FitResult,
     setup: GonioSetup,
     d: &Directions,
@@ -401,7 +406,7 @@ fn compare(
 ) -> CheckRow {
     let gonio = VirtualGonio::new(shader.clone(), setup);
     let (rendered, _) = gonio.render(&d.dirs);
-    let bsdf = Bsdf::new(material, &fit.options());
+    let bsdf = CompositeBsdf::new(material, &fit.options());
     let l = setup.light();
     let model: Vec<Rgb> = d.dirs.iter().map(|&v| bsdf.eval(l, v)).collect();
     let channels = d.channels.clamp(1, 3);
@@ -501,7 +506,7 @@ impl std::fmt::Display for CheckReport {
             f,
             "brtf check {}: {} ({}); relative differences (a − b)/sqrt(b² + floor²)",
             self.name,
-            self.kind,
+            self.shape,
             if self.table { "θ_in table" } else { "static" },
         )?;
         let mut s = String::new();

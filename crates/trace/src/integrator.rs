@@ -6,9 +6,10 @@
 //!   `Ω_i` seen from the point (`pdf = 1/ω_i`), with the whole BSDF `f` and a
 //!   shadow ray.
 //! * **Specular rays.** The rough reflected and transmitted lobes are
-//!   importance-sampled ([`crate::sampling`]) and weighted by the specular
-//!   part `f_s = f − f_d`. Such rays ignore the sources (the direct term
-//!   has them) and recurse up to [`Settings::max_depth`]. Roughness-0
+//!   importance-sampled ([`crate::sampling`]; a lobe sum's lobes as a
+//!   mixture) and weighted by the specular part `f_s = f − f_d`. Such
+//!   rays ignore the sources (the direct term has them) and recurse up to
+//!   [`Settings::max_depth`]. Roughness-0
 //!   surfaces trace their mirror and straight-through rays instead, with
 //!   the delta coefficients; those rays *do* see sources.
 //! * **Diffuse bounce** (optional, [`Settings::diffuse_samples`] > 0):
@@ -24,16 +25,16 @@ use crate::sampling::cosine_hemisphere;
 use crate::scene::{Hit, PreparedSource, RAY_EPSILON, Ray, Scene};
 use brtf_model::Rng;
 
-use crate::sampling::{ReflectionLobe, TransmissionLobe};
+use crate::sampling::{LobeMix, ReflectionLobe, TransmissionLobe};
 
-/// One rough specular lobe to sample.
+/// The rough specular lobes of one side to sample (a mixture for a lobe sum).
 #[derive(Debug, Clone, Copy)]
-enum SpecularLobe {
-    Reflect(ReflectionLobe),
-    Transmit(TransmissionLobe),
+enum SpecularLobe<'a> {
+    Reflect(LobeMix<'a, ReflectionLobe>),
+    Transmit(LobeMix<'a, TransmissionLobe>),
 }
 
-impl SpecularLobe {
+impl SpecularLobe<'_> {
     /// +1 for the front (reflection), −1 for the back.
     fn side(&self) -> f64 {
         match self {
@@ -46,14 +47,8 @@ impl SpecularLobe {
     #[inline]
     fn sample(&self, v: DVec3, u: [f64; 2]) -> (DVec3, f64) {
         match self {
-            SpecularLobe::Reflect(lobe) => {
-                let l = lobe.sample(v, u);
-                (l, lobe.pdf(v, l))
-            }
-            SpecularLobe::Transmit(lobe) => {
-                let l = lobe.sample(v, u);
-                (l, lobe.pdf(v, l))
-            }
+            SpecularLobe::Reflect(lobes) => lobes.sample_with_pdf(v, u),
+            SpecularLobe::Transmit(lobes) => lobes.sample_with_pdf(v, u),
         }
     }
 }
@@ -64,7 +59,8 @@ pub struct Settings {
     /// Shadow rays per source at a camera ray's hit (1 deeper down).
     pub source_samples: u32,
     /// Rays per rough specular lobe at a camera ray's hit (1 deeper down;
-    /// 0 disables specular rays).
+    /// 0 disables specular rays); a lobe sum's lobes of one side share
+    /// them, each ray from the mixture.
     pub specular_samples: u32,
     /// One-bounce diffuse rays per diffuse part at a camera ray's hit (0: off).
     pub diffuse_samples: u32,
@@ -440,9 +436,7 @@ impl Tracer<'_> {
         let no_rays = (s.specular_samples == 0 || s.max_depth == 0) && s.diffuse_samples == 0;
         no_rays
             && self.scene.shaders.iter().all(|shader| {
-                !shader.has_delta()
-                    && shader.single_bsdf().is_some()
-                    && !shader.kind().is_anisotropic()
+                !shader.has_delta() && shader.single_bsdf().is_some() && !shader.is_anisotropic()
             })
     }
 

@@ -23,9 +23,14 @@
 //!   `Ω_i` with the whole BSDF `f` (brtf-model, evaluated for a point
 //!   source: the source's extent is integrated, not modelled by widening);
 //! * the specular part `f_s = f − f_d` is integrated with rays
-//!   importance-sampled from the Gaussian lobes ([`sampling`]); roughness-0
-//!   surfaces trace their mirror and straight-through rays;
+//!   importance-sampled from the Gaussian lobes ([`sampling`]; a lobe
+//!   sum's lobes as a mixture); roughness-0 surfaces trace their mirror
+//!   and straight-through rays;
 //! * the diffuse part `f_d` optionally gets one bounce.
+//!
+//! A material is a [`brtf_model::Composite`]: one Radiance primitive, or
+//! a lobe sum mixed with constant weights, rendered as rtrace renders a
+//! constant `mixfunc` tree, every term the weighted sum of the lobes'.
 //!
 //! ## Conventions
 //!
@@ -59,12 +64,12 @@ pub use gonio::{
 pub use image::{Rendered, auto_exposure, render, write_png};
 pub use integrator::{ImageOptions, RayCounts, Settings, Tracer};
 pub use sampling::{
-    ReflectionLobe, TransmissionLobe, cosine_hemisphere, cosine_hemisphere_pdf, one_minus_cos,
-    uniform_cone, uniform_cone_pdf,
+    DirectionSampler, LobeMix, Mixture, ReflectionLobe, TransmissionLobe, cosine_hemisphere,
+    cosine_hemisphere_pdf, one_minus_cos, uniform_cone, uniform_cone_pdf,
 };
 pub use scene::{Ray, Scene, Shape, Source};
 pub use scene_spec::{
     BALL_CENTER, FLOOR_RADIUS, LightKind, LightSpec, MATERIAL_NAME, SceneKind, SceneSpec,
     SceneSpecError, ViewSpec,
 };
-pub use shader::{Shader, ShaderError};
+pub use shader::{Lobes, Shader, ShaderError};

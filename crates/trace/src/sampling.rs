@@ -24,6 +24,12 @@
 //!   `pdf(l) = κ e^{−κ(1 − t·l)} / (2π (1 − e^{−2κ}))`.
 //!   For the anisotropic `trans2` the sampler uses the wider of the two
 //!   widths (an envelope; the weights stay bounded).
+//! * [`Mixture`]: the lobes of a lobe sum (several primitives mixed
+//!   with constant weights), sampled as a mixture: lobe k is picked with
+//!   probability `p_k` (its weight × its specularity), and a
+//!   direction drawn from it has the mixture's density
+//!   `pdf(l) = Σ_j p_j pdf_j(l)`, so `f_s cos/pdf` stays unbiased for
+//!   the sum `f_s = Σ w_k f_s,k`. One lobe is sampled exactly as on its own.
 //! * [`cosine_hemisphere`]: the diffuse parts, `pdf = |cos θ|/π`.
 //! * [`uniform_cone`]: a source of finite solid angle, `pdf = 1/ω`.
 
@@ -255,6 +261,158 @@ impl TransmissionLobe {
     }
 }
 
+/// A direction sampler of a view `v` with its density.
+pub trait DirectionSampler: Copy {
+    /// A direction for view `v` from two uniform numbers in [0, 1).
+    fn sample(&self, v: DVec3, u: [f64; 2]) -> DVec3;
+    /// Density of [`Self::sample`] at `l`, per unit solid angle.
+    fn pdf(&self, v: DVec3, l: DVec3) -> f64;
+}
+
+impl DirectionSampler for ReflectionLobe {
+    #[inline]
+    fn sample(&self, v: DVec3, u: [f64; 2]) -> DVec3 {
+        ReflectionLobe::sample(self, v, u)
+    }
+
+    #[inline]
+    fn pdf(&self, v: DVec3, l: DVec3) -> f64 {
+        ReflectionLobe::pdf(self, v, l)
+    }
+}
+
+impl DirectionSampler for TransmissionLobe {
+    #[inline]
+    fn sample(&self, v: DVec3, u: [f64; 2]) -> DVec3 {
+        TransmissionLobe::sample(self, v, u)
+    }
+
+    #[inline]
+    fn pdf(&self, v: DVec3, l: DVec3) -> f64 {
+        TransmissionLobe::pdf(self, v, l)
+    }
+}
+
+/// The largest double below 1.
+const BELOW_ONE: f64 = 1.0 - f64::EPSILON / 2.0;
+
+/// Lobes sampled as a mixture: lobe k picked with probability `p_k`, the
+/// direction's density that of the mixture, `Σ_j p_j pdf_j`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mixture<T> {
+    lobes: Vec<T>,
+    /// `p_k`, summing to 1.
+    probability: Vec<f64>,
+    /// `p_0 + … + p_k`, the last exactly 1.
+    cumulative: Vec<f64>,
+}
+
+impl<T: DirectionSampler> Mixture<T> {
+    /// Lobes picked with probabilities proportional to `weights` (lobes of
+    /// weight 0 or less are left out). `None` when no weight is positive
+    /// and finite.
+    pub fn new(weighted: &[(f64, T)]) -> Option<Mixture<T>> {
+        let total: f64 = weighted
+            .iter()
+            .map(|(w, _)| if *w > 0.0 { *w } else { 0.0 })
+            .sum();
+        if !(total > 0.0 && total.is_finite()) {
+            return None;
+        }
+        let kept = weighted.iter().filter(|(w, _)| *w > 0.0);
+        let lobes: Vec<T> = kept.clone().map(|(_, lobe)| *lobe).collect();
+        let probability: Vec<f64> = kept.map(|(w, _)| w / total).collect();
+        let mut cumulative: Vec<f64> = probability
+            .iter()
+            .scan(0.0, |sum, p| {
+                *sum += p;
+                Some(*sum)
+            })
+            .collect();
+        *cumulative.last_mut().expect("a positive weight") = 1.0;
+        Some(Mixture {
+            lobes,
+            probability,
+            cumulative,
+        })
+    }
+
+    /// The lobes and their probabilities.
+    pub fn lobes(&self) -> impl Iterator<Item = (f64, &T)> {
+        self.probability.iter().copied().zip(&self.lobes)
+    }
+
+    /// A direction: a lobe picked by `u[0]`, which is then stretched back
+    /// to [0, 1) for the lobe's own sampler.
+    #[inline]
+    pub fn sample(&self, v: DVec3, u: [f64; 2]) -> DVec3 {
+        let n = self.lobes.len();
+        let k = self.cumulative[..n - 1]
+            .iter()
+            .position(|&c| u[0] < c)
+            .unwrap_or(n - 1);
+        let below = if k == 0 { 0.0 } else { self.cumulative[k - 1] };
+        let stretched = ((u[0] - below) / self.probability[k]).clamp(0.0, BELOW_ONE);
+        self.lobes[k].sample(v, [stretched, u[1]])
+    }
+
+    /// The mixture's density at `l`, per unit solid angle.
+    #[inline]
+    pub fn pdf(&self, v: DVec3, l: DVec3) -> f64 {
+        self.lobes().map(|(p, lobe)| p * lobe.pdf(v, l)).sum()
+    }
+}
+
+/// The rough lobes of one side to sample: one lobe as it is, or a lobe
+/// sum's lobes as a [`Mixture`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum LobeMix<'a, T> {
+    /// One lobe, sampled (bit for bit) as the lobe itself.
+    One(T),
+    /// Several lobes.
+    Many(&'a Mixture<T>),
+}
+
+impl<T: DirectionSampler> LobeMix<'_, T> {
+    /// Number of lobes.
+    pub fn len(&self) -> usize {
+        match self {
+            LobeMix::One(_) => 1,
+            LobeMix::Many(m) => m.lobes.len(),
+        }
+    }
+
+    /// Never true: there is a lobe.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// A direction for view `v`.
+    #[inline]
+    pub fn sample(&self, v: DVec3, u: [f64; 2]) -> DVec3 {
+        match self {
+            LobeMix::One(lobe) => lobe.sample(v, u),
+            LobeMix::Many(m) => m.sample(v, u),
+        }
+    }
+
+    /// Density of [`Self::sample`] at `l`, per unit solid angle.
+    #[inline]
+    pub fn pdf(&self, v: DVec3, l: DVec3) -> f64 {
+        match self {
+            LobeMix::One(lobe) => lobe.pdf(v, l),
+            LobeMix::Many(m) => m.pdf(v, l),
+        }
+    }
+
+    /// [`Self::sample`] and its density.
+    #[inline]
+    pub fn sample_with_pdf(&self, v: DVec3, u: [f64; 2]) -> (DVec3, f64) {
+        let l = self.sample(v, u);
+        (l, self.pdf(v, l))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -296,6 +454,34 @@ mod tests {
         assert_eq!(sin_cos_turns(0.25), (1.0, 0.0));
         assert_eq!(sin_cos_turns(0.5), (0.0, -1.0));
         assert_eq!(sin_cos_turns(0.75), (-1.0, 0.0));
+    }
+
+    #[test]
+    fn mixtures_pick_lobes_by_weight() {
+        let (a, b) = (
+            ReflectionLobe::isotropic(0.05),
+            ReflectionLobe::isotropic(0.3),
+        );
+        let unused = ReflectionLobe::isotropic(0.1);
+        let m = Mixture::new(&[(0.5, a), (0.0, unused), (1.5, b)]).unwrap();
+        let picks: Vec<(f64, ReflectionLobe)> = m.lobes().map(|(p, l)| (p, *l)).collect();
+        assert_eq!(picks, vec![(0.25, a), (0.75, b)]);
+        let v = DVec3::new(0.3, 0.1, 0.9).normalize();
+        // u[0] picks the lobe and is stretched back to [0, 1) for it.
+        assert_eq!(m.sample(v, [0.1, 0.3]), a.sample(v, [0.4, 0.3]));
+        assert_eq!(m.sample(v, [0.625, 0.3]), b.sample(v, [0.5, 0.3]));
+        assert!(m.sample(v, [1.0 - 1e-17, 0.3]).is_finite());
+        let l = DVec3::new(-0.2, 0.0, 0.95).normalize();
+        let want = 0.25 * a.pdf(v, l) + 0.75 * b.pdf(v, l);
+        assert!((m.pdf(v, l) - want).abs() <= 1e-15 * want);
+        // One lobe is the lobe itself, bit for bit.
+        let one = LobeMix::One(a);
+        let u = [0.37, 0.81];
+        assert_eq!(
+            one.sample_with_pdf(v, u),
+            (a.sample(v, u), a.pdf(v, a.sample(v, u)))
+        );
+        assert!(Mixture::new(&[(0.0, a)]).is_none());
     }
 
     #[test]

@@ -2,7 +2,13 @@
 //! parts of Radiance's equation (1), and the lobes to sample.
 //!
 //! A [`Shader`] is either one material or a θ_in-dependent material from
-//! a fit's [`ParamTable`]. A table material is evaluated with the
+//! a fit's [`ParamTable`]. A material is a [`Composite`]: one primitive,
+//! or a lobe sum of primitives mixed with constant weights `w_k`, shaded
+//! as rtrace shades a constant `mixfunc` tree, term by term the weighted
+//! sum `f = Σ w_k f_k` (the direct term, the diffuse part and the
+//! specular part alike); the specular rays sample the lobes as a mixture
+//! ([`crate::LobeMix`]). A one-primitive material is shaded exactly as
+//! the primitive alone. A table material is evaluated with the
 //! parameters at the **light's** polar angle θ_l = acos|l·n| (the
 //! incidence of the measurement it was fitted to): the table is sampled
 //! on a 0.25° grid once, and `f` is interpolated linearly between the two
@@ -24,13 +30,29 @@
 //! the shader splits `f = f_d + f_s`: [`Shader::diffuse`] is the diffuse
 //! part `C R_d/π` (and `C T_d/π` behind), brtf-model's
 //! [`Bsdf::eval_diffuse`]; `f_s = f − f_d`.
+//!
+//! ## Orientations
+//!
+//! The anisotropic types' frame has x along the material's orientation
+//! vector projected on the surface (Radiance's `û`); the primitives of one
+//! material share it (a mixture whose anisotropic primitives have
+//! different vectors is refused). A table whose orientation angle is
+//! fitted (`orient`) turns with θ_in: its materials are shaded in the
+//! frame of one reference angle (the middle of the table's range) with
+//! each grid material's orientation turned by its own angle from it, in
+//! the tangent plane. On the flat sample of the gonio-photometer (normal
+//! +z) that is exactly Radiance's projection of `(cos ψ, sin ψ, 0)`; on a
+//! curved surface it is the same turn about the normal.
 
 use brtf_fit::{ParamTable, TableError};
-use brtf_model::{Bsdf, EvalOptions, FTINY, Material, MaterialKind, Rgb, Variant};
+use brtf_model::{
+    Bsdf, Composite, EvalOptions, FTINY, Material, MaterialKind, Rgb, ShapeArg, Variant,
+    orientation_of_angle,
+};
 use glam::DVec3;
 
 use crate::frame::Frame;
-use crate::sampling::{ReflectionLobe, TransmissionLobe};
+use crate::sampling::{LobeMix, Mixture, ReflectionLobe, TransmissionLobe};
 
 /// Grid step (degrees) of a θ_in-table shader.
 pub(crate) const TABLE_STEP_DEG: f64 = 0.25;
@@ -44,12 +66,13 @@ const MIN_VIEW_COSINE: f64 = 0.001;
 /// What the view direction alone decides: which lobes exist and how to
 /// sample them.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Lobes {
-    /// The rough reflected lobe, if the material has one.
-    pub reflect: Option<ReflectionLobe>,
-    /// The rough transmitted lobe, if any.
-    pub transmit: Option<TransmissionLobe>,
-    /// Roughness 0: mirror and straight-through delta coefficients.
+pub struct Lobes<'a> {
+    /// The rough reflected lobes, if the material has any.
+    pub reflect: Option<LobeMix<'a, ReflectionLobe>>,
+    /// The rough transmitted lobes, if any.
+    pub transmit: Option<LobeMix<'a, TransmissionLobe>>,
+    /// Roughness 0: mirror and straight-through delta coefficients (the
+    /// weighted sum over the roughness-0 primitives).
     pub delta: Option<(Rgb, Rgb)>,
     /// A diffuse reflection part exists.
     pub diffuse_reflect: bool,
@@ -57,10 +80,20 @@ pub struct Lobes {
     pub diffuse_transmit: bool,
 }
 
-/// One material prepared for shading.
+/// One primitive's [`Lobes`].
+struct PrimitiveLobes {
+    reflect: Option<ReflectionLobe>,
+    transmit: Option<TransmissionLobe>,
+    delta: Option<(Rgb, Rgb)>,
+    diffuse_reflect: bool,
+    diffuse_transmit: bool,
+}
+
+/// One primitive prepared for shading.
 #[derive(Debug, Clone)]
-struct Entry {
-    /// Built with the orientation along local x.
+struct Primitive {
+    /// Built with the orientation along local x (or turned from it, for a
+    /// table's fitted orientation).
     bsdf: Bsdf,
     /// Anisotropic types only: built with the orientation along the
     /// normal (rtrace's arbitrary tangent and mean roughness).
@@ -68,34 +101,39 @@ struct Entry {
     kind: MaterialKind,
     /// The specularity argument (before any Fresnel estimate).
     spec: f64,
+    /// The transmissivity argument (0 for the opaque types).
+    trans: f64,
     tspec: f64,
     alpha2: (f64, f64),
     variant: Variant,
 }
 
-impl Entry {
-    fn new(material: &Material, options: &EvalOptions) -> Entry {
+impl Primitive {
+    /// `material` in the shading frame, its orientation vector there
+    /// being `local` (x unless a table turns it).
+    fn new(material: &Material, local: DVec3, options: &EvalOptions) -> Primitive {
         let kind = material.kind();
         let args = material.args();
-        let along = Material::new(kind, args, Some(DVec3::X)).expect("valid material");
+        let along = Material::new(kind, args, Some(local)).expect("valid material");
         let degenerate = kind
             .is_anisotropic()
             .then(|| Material::new(kind, args, Some(DVec3::Z)).expect("valid material"));
-        let tspec = match kind {
-            MaterialKind::Trans => args[6],
-            MaterialKind::Trans2 => args[7],
-            _ => 0.0,
+        let (trans, tspec) = match kind {
+            MaterialKind::Trans => (args[5], args[6]),
+            MaterialKind::Trans2 => (args[6], args[7]),
+            _ => (0.0, 0.0),
         };
         let alpha2 = if kind.is_anisotropic() {
             (args[4] * args[4], args[5] * args[5])
         } else {
             (args[4] * args[4], args[4] * args[4])
         };
-        Entry {
+        Primitive {
             bsdf: Bsdf::new(&along, options),
             degenerate: degenerate.map(|m| Bsdf::new(&m, options)),
             kind,
             spec: material.spec(),
+            trans,
             tspec,
             alpha2,
             variant: options.variant,
@@ -116,7 +154,7 @@ impl Entry {
         self.bsdf.eval_diffuse(l, v)
     }
 
-    fn lobes(&self, v: DVec3, degenerate: bool) -> Lobes {
+    fn lobes(&self, v: DVec3, degenerate: bool) -> PrimitiveLobes {
         let view_cosine = v.z.max(MIN_VIEW_COSINE);
         let split = self.bsdf.view_split(view_cosine);
         let (spec, t, rd) = (split.spec, split.transmitted, split.diffuse);
@@ -135,13 +173,182 @@ impl Entry {
         let pure = self.bsdf.is_pure();
         let reflecting = t < 1.0 - FTINY;
         let transmitting = t > FTINY;
-        Lobes {
+        PrimitiveLobes {
             reflect: (!pure && spec_on && reflecting).then_some(ReflectionLobe { wu, wv }),
             transmit: (!pure && ts > FTINY && transmitting)
                 .then_some(TransmissionLobe { beta: wu.max(wv) }),
             delta: pure.then(|| self.bsdf.delta_coefficients(view_cosine)),
             diffuse_reflect: reflecting && (rd > FTINY || ward_metal),
             diffuse_transmit: transmitting && t - ts > FTINY,
+        }
+    }
+}
+
+/// The least share of a lobe's specularity in picking it from a mixture
+/// (a spec-0 lobe still has a lobe under Ward 1992's Fresnel term).
+const MIN_PICK_SPEC: f64 = 0.02;
+
+/// One material prepared for shading: its primitives and their weights.
+#[derive(Debug, Clone)]
+struct Entry {
+    /// `(w_k, primitive k)`, weights summing to 1 (at least one).
+    parts: Vec<(f64, Primitive)>,
+    /// Several primitives: their rough lobes as mixtures, for the
+    /// orientation off and along the normal (`[normal, degenerate]`).
+    reflect: [Option<Mixture<ReflectionLobe>>; 2],
+    transmit: [Option<Mixture<TransmissionLobe>>; 2],
+}
+
+/// `Σ w_k value(k)` over `parts`; one part's value as it is.
+#[inline]
+fn weighted(parts: &[(f64, Primitive)], value: impl Fn(&Primitive) -> Rgb) -> Rgb {
+    if let [(_, p)] = parts {
+        return value(p);
+    }
+    let mut sum = [0.0; 3];
+    for (w, p) in parts {
+        let f = value(p);
+        for k in 0..3 {
+            sum[k] += w * f[k];
+        }
+    }
+    sum
+}
+
+impl Entry {
+    /// `material` in a frame whose x axis is the projection of
+    /// `reference` (see the module docs on orientations).
+    fn new(material: &Composite, reference: DVec3, options: &EvalOptions) -> Entry {
+        let flat = Frame::from_z_and_x(DVec3::Z, reference).unwrap_or(Frame::WORLD);
+        let parts: Vec<(f64, Primitive)> = material
+            .components()
+            .iter()
+            .map(|(w, m)| {
+                let o = m.orientation();
+                // The reference itself is x exactly (the one-material case).
+                let local = if o == reference || !m.kind().is_anisotropic() {
+                    DVec3::X
+                } else {
+                    flat.to_local(o)
+                };
+                (*w, Primitive::new(m, local, options))
+            })
+            .collect();
+        let mut entry = Entry {
+            parts,
+            reflect: [None, None],
+            transmit: [None, None],
+        };
+        if entry.parts.len() > 1 {
+            for degenerate in [false, true] {
+                let i = usize::from(degenerate);
+                entry.reflect[i] = entry.mixture(degenerate, |p, (wu, wv)| {
+                    (p.spec.max(MIN_PICK_SPEC), ReflectionLobe { wu, wv })
+                });
+                entry.transmit[i] = entry.mixture(degenerate, |p, (wu, wv)| {
+                    let energy = p.trans * p.tspec;
+                    let lobe = TransmissionLobe { beta: wu.max(wv) };
+                    (
+                        if energy > 0.0 {
+                            energy.max(MIN_PICK_SPEC)
+                        } else {
+                            0.0
+                        },
+                        lobe,
+                    )
+                });
+            }
+        }
+        entry
+    }
+
+    /// The rough lobes of the primitives of weight > 0 as a mixture, each
+    /// picked with probability ∝ `w_k × energy`, `lobe(primitive, (α_u²,
+    /// α_v²))` giving `(energy, lobe)`.
+    fn mixture<T: crate::DirectionSampler>(
+        &self,
+        degenerate: bool,
+        lobe: impl Fn(&Primitive, (f64, f64)) -> (f64, T),
+    ) -> Option<Mixture<T>> {
+        let weighted: Vec<(f64, T)> = self
+            .parts
+            .iter()
+            .filter(|(w, p)| *w > 0.0 && !p.bsdf.is_pure())
+            .map(|(w, p)| {
+                let (wu, wv) = p.alpha2;
+                let widths = if degenerate {
+                    (0.5 * (wu + wv), 0.5 * (wu + wv))
+                } else {
+                    (wu, wv)
+                };
+                let (energy, lobe) = lobe(p, widths);
+                (w * energy, lobe)
+            })
+            .collect();
+        Mixture::new(&weighted)
+    }
+
+    #[inline]
+    fn eval(&self, l: DVec3, v: DVec3, degenerate: bool) -> Rgb {
+        weighted(&self.parts, |p| p.bsdf(degenerate).eval(l, v))
+    }
+
+    #[inline]
+    fn diffuse(&self, l: DVec3, v: DVec3) -> Rgb {
+        weighted(&self.parts, |p| p.diffuse(l, v))
+    }
+
+    fn is_pure(&self) -> bool {
+        self.parts.iter().any(|(_, p)| p.bsdf.is_pure())
+    }
+
+    /// The lobes for view `v`: one primitive's own; for several, the
+    /// mixtures of their rough lobes when any is on for this view, the
+    /// weighted sum of their deltas, and the diffuse parts of any.
+    fn lobes(&self, v: DVec3, degenerate: bool) -> Lobes<'_> {
+        if let [(_, p)] = self.parts.as_slice() {
+            let one = p.lobes(v, degenerate);
+            return Lobes {
+                reflect: one.reflect.map(LobeMix::One),
+                transmit: one.transmit.map(LobeMix::One),
+                delta: one.delta,
+                diffuse_reflect: one.diffuse_reflect,
+                diffuse_transmit: one.diffuse_transmit,
+            };
+        }
+        let (mut reflect, mut transmit) = (false, false);
+        let mut delta: Option<(Rgb, Rgb)> = None;
+        let (mut diffuse_reflect, mut diffuse_transmit) = (false, false);
+        for (w, p) in &self.parts {
+            if *w <= 0.0 {
+                continue;
+            }
+            let one = p.lobes(v, degenerate);
+            reflect |= one.reflect.is_some();
+            transmit |= one.transmit.is_some();
+            if let Some((mirror, through)) = one.delta {
+                let (m, t) = delta.get_or_insert(([0.0; 3], [0.0; 3]));
+                for k in 0..3 {
+                    m[k] += w * mirror[k];
+                    t[k] += w * through[k];
+                }
+            }
+            diffuse_reflect |= one.diffuse_reflect;
+            diffuse_transmit |= one.diffuse_transmit;
+        }
+        let i = usize::from(degenerate);
+        Lobes {
+            reflect: self.reflect[i]
+                .as_ref()
+                .filter(|_| reflect)
+                .map(LobeMix::Many),
+            transmit: self.transmit[i]
+                .as_ref()
+                .filter(|_| transmit)
+                .map(LobeMix::Many),
+            delta,
+            diffuse_reflect,
+            diffuse_transmit,
         }
     }
 }
@@ -153,6 +360,12 @@ pub enum ShaderError {
     /// The fit's θ_in table gives an invalid material somewhere.
     #[error("θ_in table: {0}")]
     Table(#[from] TableError),
+    /// Anisotropic primitives with different orientation vectors.
+    #[error(
+        "the anisotropic primitives of a mixture have different orientation vectors \
+         ({0:?} and {1:?}): brtf-trace renders mixtures of one orientation"
+    )]
+    Orientations([f64; 3], [f64; 3]),
 }
 
 /// A material ready for shading: one material or a θ_in table.
@@ -161,8 +374,10 @@ pub struct Shader {
     entries: Vec<Entry>,
     /// `Some(step)` for a table shader.
     step: Option<f64>,
+    /// The orientation vector whose projection is the frame's x axis.
     orientation: DVec3,
     anisotropic: bool,
+    transmitting: bool,
     options: EvalOptions,
     /// Some entry has roughness 0 (mirror and straight-through deltas).
     has_delta: bool,
@@ -222,33 +437,59 @@ impl AzimuthGrid {
     }
 }
 
+/// The orientation shared by the anisotropic primitives of `material`
+/// (its own vector when it has none), or why there is none.
+fn shared_orientation(material: &Composite) -> Result<DVec3, ShaderError> {
+    let mut oriented = material
+        .components()
+        .iter()
+        .map(|(_, m)| m)
+        .filter(|m| m.kind().is_anisotropic())
+        .map(|m| m.orientation());
+    let Some(first) = oriented.next() else {
+        return Ok(material.orientation());
+    };
+    match oriented.find(|o| *o != first) {
+        Some(other) => Err(ShaderError::Orientations(
+            first.to_array(),
+            other.to_array(),
+        )),
+        None => Ok(first),
+    }
+}
+
 impl Shader {
-    /// One material. `options.source_omega` is ignored (set to 0): sources
-    /// are integrated by sampling.
-    pub fn new(material: &Material, options: &EvalOptions) -> Shader {
+    /// One material (one primitive or a lobe sum). `options.source_omega`
+    /// is ignored (set to 0): sources are integrated by sampling.
+    pub fn new(material: &Composite, options: &EvalOptions) -> Result<Shader, ShaderError> {
         let options = point_options(options);
-        let entry = Entry::new(material, &options);
-        Shader {
-            has_delta: entry.bsdf.is_pure(),
+        let orientation = shared_orientation(material)?;
+        let entry = Entry::new(material, orientation, &options);
+        Ok(Shader {
+            has_delta: entry.is_pure(),
             entries: vec![entry],
             step: None,
-            orientation: material.orientation(),
-            anisotropic: material.kind().is_anisotropic(),
+            orientation,
+            anisotropic: any_part(material, MaterialKind::is_anisotropic),
+            transmitting: any_part(material, MaterialKind::is_transmitting),
             options,
             azimuth: None,
-        }
+        })
     }
 
-    /// A θ_in-dependent material from a fit's parameter table.
+    /// A θ_in-dependent material from a fit's parameter table (of any
+    /// shape: lobe sums, fitted orientations).
     pub fn from_table(table: &ParamTable, options: &EvalOptions) -> Result<Shader, ShaderError> {
         let options = point_options(options);
+        let reference = table_reference(table);
+        let prepare = |material: &Composite| -> Result<Entry, ShaderError> {
+            shared_orientation(material)?;
+            Ok(Entry::new(material, reference, &options))
+        };
         let n = (90.0 / TABLE_STEP_DEG).round() as usize;
         let entries = (0..=n)
-            .map(|i| {
-                let lookup = table.at(i as f64 * TABLE_STEP_DEG)?;
-                Ok(Entry::new(&lookup.material, &options))
-            })
-            .collect::<Result<Vec<_>, TableError>>()?;
+            .map(|i| prepare(&table.composite_at(i as f64 * TABLE_STEP_DEG)?.0))
+            .collect::<Result<Vec<_>, ShaderError>>()?;
         let azimuth = if table.depends_on_azimuth() {
             let (theta_step, phi_step) = AZIMUTH_GRID_STEP_DEG;
             let rows = (90.0 / theta_step).round() as usize + 1;
@@ -257,31 +498,47 @@ impl Shader {
                 .map(|k| {
                     let theta = (k / columns) as f64 * theta_step;
                     let phi = (k % columns) as f64 * phi_step;
-                    let lookup = table.at_direction(theta, phi)?;
-                    Ok(Entry::new(&lookup.material, &options))
+                    prepare(&table.composite_at_direction(theta, phi)?.0)
                 })
-                .collect::<Result<Vec<_>, TableError>>()?;
+                .collect::<Result<Vec<_>, ShaderError>>()?;
             Some(AzimuthGrid { entries, columns })
         } else {
             None
         };
         Ok(Shader {
-            has_delta: entries.iter().any(|e| e.bsdf.is_pure())
+            has_delta: entries.iter().any(Entry::is_pure)
                 || azimuth
                     .as_ref()
-                    .is_some_and(|g| g.entries.iter().any(|e| e.bsdf.is_pure())),
+                    .is_some_and(|g| g.entries.iter().any(Entry::is_pure)),
             entries,
             step: Some(TABLE_STEP_DEG),
-            orientation: DVec3::from_array(table.orientation),
+            orientation: reference,
             anisotropic: table.kind.is_anisotropic(),
+            transmitting: table.kind.is_transmitting(),
             options,
             azimuth,
         })
     }
 
-    /// The material type.
+    /// The material type (of the first primitive of a mixture).
     pub fn kind(&self) -> MaterialKind {
-        self.entries[0].kind
+        self.entries[0].parts[0].1.kind
+    }
+
+    /// True when some primitive is anisotropic (the frame follows the
+    /// orientation).
+    pub fn is_anisotropic(&self) -> bool {
+        self.anisotropic
+    }
+
+    /// True when some primitive transmits light.
+    pub fn is_transmitting(&self) -> bool {
+        self.transmitting
+    }
+
+    /// Primitives per material: 1, or a lobe sum's lobes.
+    pub fn lobe_count(&self) -> usize {
+        self.entries[0].parts.len()
     }
 
     /// True if the material (or some θ_in of a table) has roughness 0, so
@@ -290,11 +547,14 @@ impl Shader {
         self.has_delta
     }
 
-    /// The one BSDF of a single-material shader (`None` for a table),
-    /// for batch evaluation: [`Self::eval`] with `degenerate = false` is
-    /// this BSDF's `eval`.
+    /// The one BSDF of a one-primitive, single-material shader (`None`
+    /// for a table or a lobe sum), for batch evaluation: [`Self::eval`]
+    /// with `degenerate = false` is this BSDF's `eval`.
     pub(crate) fn single_bsdf(&self) -> Option<&Bsdf> {
-        self.step.is_none().then(|| &self.entries[0].bsdf)
+        match (self.step, self.entries[0].parts.as_slice()) {
+            (None, [(_, p)]) => Some(&p.bsdf),
+            _ => None,
+        }
     }
 
     /// True for a θ_in-table shader.
@@ -336,22 +596,24 @@ impl Shader {
         }
     }
 
-    /// The whole BSDF `f(l, v)` (1/sr, no cosine), local frame.
+    /// The whole BSDF `f(l, v)` (1/sr, no cosine), local frame: the
+    /// weighted sum of the primitives'.
     #[inline]
     pub fn eval(&self, l: DVec3, v: DVec3, degenerate: bool) -> Rgb {
         if let (Some(grid), false) = (&self.azimuth, degenerate) {
-            return grid.mix(l, |e| e.bsdf(false).eval(l, v));
+            return grid.mix(l, |e| e.eval(l, v, false));
         }
         let (i, j, t) = self.blend(l.z);
-        let a = self.entries[i].bsdf(degenerate).eval(l, v);
+        let a = self.entries[i].eval(l, v, degenerate);
         if t == 0.0 {
             return a;
         }
-        let b = self.entries[j].bsdf(degenerate).eval(l, v);
+        let b = self.entries[j].eval(l, v, degenerate);
         std::array::from_fn(|k| a[k] + t * (b[k] - a[k]))
     }
 
-    /// The diffuse part `f_d(l, v)` of [`Self::eval`] (`v.z ≥ 0`).
+    /// The diffuse part `f_d(l, v)` of [`Self::eval`] (`v.z ≥ 0`): the
+    /// weighted sum of the primitives' diffuse parts.
     #[inline]
     pub fn diffuse(&self, l: DVec3, v: DVec3) -> Rgb {
         if let Some(grid) = &self.azimuth {
@@ -377,10 +639,34 @@ impl Shader {
     /// The lobes to sample for view `v` (`v.z ≥ 0`). A table shader uses
     /// the material at θ_l = θ_v, where the reflected lobe peaks.
     #[inline]
-    pub fn lobes(&self, v: DVec3, degenerate: bool) -> Lobes {
+    pub fn lobes(&self, v: DVec3, degenerate: bool) -> Lobes<'_> {
         let (i, j, t) = self.blend(v.z);
         let e = if t < 0.5 { i } else { j };
         self.entries[e].lobes(v, degenerate)
+    }
+}
+
+/// True when some primitive of `material` is of a kind for which `test` holds.
+fn any_part(material: &Composite, test: impl Fn(MaterialKind) -> bool) -> bool {
+    material.components().iter().any(|(_, m)| test(m.kind()))
+}
+
+/// The orientation vector whose projection is a table shader's frame x:
+/// the table's own, or for a fitted orientation (not following φ_in) the
+/// middle of its angles' range.
+fn table_reference(table: &ParamTable) -> DVec3 {
+    let fitted = table
+        .shape()
+        .index_of(ShapeArg::Orient)
+        .filter(|_| !table.depends_on_azimuth());
+    match fitted {
+        Some(o) => {
+            let angles = table.args.iter().map(|row| row[o]);
+            let lo = angles.clone().fold(f64::INFINITY, f64::min);
+            let hi = angles.fold(f64::NEG_INFINITY, f64::max);
+            orientation_of_angle(0.5 * (lo + hi))
+        }
+        None => DVec3::from_array(table.orientation),
     }
 }
 

@@ -2,12 +2,18 @@
 
 #![allow(dead_code)]
 
-use brtf_model::{EvalOptions, Material, MaterialKind};
+use brtf_model::{Composite, EvalOptions, Material, MaterialKind, Shape};
+use brtf_trace::Shader;
 use glam::DVec3;
 
 /// A material from its kind and arguments (orientation +x for `*2`).
 pub(crate) fn mat(kind: MaterialKind, args: &[f64]) -> Material {
     Material::new(kind, args, Some(DVec3::new(1.0, 0.3, 0.0))).expect("valid material")
+}
+
+/// The shader of one primitive.
+pub(crate) fn shader_of(material: &Material, options: &EvalOptions) -> Shader {
+    Shader::new(&Composite::from_material(material), options).expect("one primitive")
 }
 
 /// Default options (radiance variant, ω = 0).
@@ -30,6 +36,79 @@ pub(crate) fn zoo() -> Vec<(&'static str, Material)> {
             mat(Trans2, &[0.7, 0.7, 0.7, 0.05, 0.15, 0.2, 0.5, 0.6]),
         ),
     ]
+}
+
+/// A lobe sum of `lobes` lobes of `kind` (orientation fitted when
+/// `oriented`, else +x turned a little) from its flat arguments.
+pub(crate) fn lobe_sum(
+    kind: MaterialKind,
+    lobes: usize,
+    oriented: bool,
+    args: &[f64],
+) -> Composite {
+    let shape = Shape::new(kind, lobes, oriented).expect("a shape");
+    Composite::new(shape, args, Some(DVec3::new(1.0, 0.3, 0.0))).expect("valid lobe sum")
+}
+
+/// Lobe sums of every plastic and metal type, and a mixture of types as
+/// a `.rad` file's constant `mixfunc` tree can give (no roughness 0).
+pub(crate) fn lobe_sums() -> Vec<(&'static str, Composite)> {
+    use MaterialKind::*;
+    vec![
+        // red green blue spec split1 rough1 rough2
+        (
+            "metal ×2",
+            lobe_sum(Metal, 2, false, &[0.9, 0.85, 0.8, 0.9, 0.35, 0.05, 0.25]),
+        ),
+        // … split1 split2 rough1 rough2 rough3
+        (
+            "plastic ×3",
+            lobe_sum(
+                Plastic,
+                3,
+                false,
+                &[0.6, 0.5, 0.4, 0.08, 0.3, 0.5, 0.04, 0.12, 0.3],
+            ),
+        ),
+        // … split1 rough_u1 rough_v1 rough_u2 rough_v2 orient
+        (
+            "plastic2 ×2 oriented",
+            lobe_sum(
+                Plastic2,
+                2,
+                true,
+                &[0.5, 0.5, 0.5, 0.1, 0.4, 0.05, 0.2, 0.3, 0.1, 30.0],
+            ),
+        ),
+        (
+            "metal2 ×2",
+            lobe_sum(
+                Metal2,
+                2,
+                false,
+                &[0.8, 0.8, 0.9, 0.8, 0.6, 0.3, 0.1, 0.08, 0.15],
+            ),
+        ),
+        (
+            "plastic + metal2 + trans mixture",
+            Composite::mixture(vec![
+                (0.3, mat(Plastic, &[0.6, 0.5, 0.4, 0.05, 0.1])),
+                (0.5, mat(Metal2, &[0.8, 0.8, 0.9, 0.8, 0.3, 0.1])),
+                (0.2, mat(Trans, &[0.8, 0.8, 0.7, 0.04, 0.12, 0.6, 0.5])),
+            ])
+            .expect("valid mixture"),
+        ),
+    ]
+}
+
+/// A mixture with a roughness-0 primitive (mirror deltas).
+pub(crate) fn mirror_mixture() -> Composite {
+    use MaterialKind::*;
+    Composite::mixture(vec![
+        (0.6, mat(Metal, &[0.9, 0.8, 0.6, 0.9, 0.2])),
+        (0.4, mat(Plastic, &[0.5, 0.5, 0.5, 0.05, 0.0])),
+    ])
+    .expect("valid mixture")
 }
 
 /// Regularised upper incomplete gamma Q(a, x) (Numerical Recipes: series

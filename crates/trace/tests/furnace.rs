@@ -5,9 +5,9 @@
 //! integrals are equal). Specular lobes are importance-sampled, diffuse
 //! parts get the one-bounce rays, roughness-0 surfaces trace their deltas.
 
-use crate::common::{mat, zoo};
+use crate::common::{lobe_sum, lobe_sums, mat, mirror_mixture, shader_of, zoo};
 use brtf_model::Rng;
-use brtf_model::{Bsdf, EvalOptions, MaterialKind, albedo};
+use brtf_model::{Bsdf, CompositeBsdf, EvalOptions, MaterialKind, albedo, composite_albedo};
 use brtf_trace::{Ray, RayCounts, Scene, Settings, Shader, Shape, Tracer};
 use glam::DVec3;
 
@@ -67,7 +67,7 @@ fn white_furnace_gives_albedo_times_radiance() {
         for theta in [0.0, 40.0, 70.0] {
             let v = brtf_model::direction(theta, 25.0);
             let a = albedo(&bsdf, v, 1e-6);
-            let (got, _) = furnace_radiance(Shader::new(&material, &options), v, background, 4096);
+            let (got, _) = furnace_radiance(shader_of(&material, &options), v, background, 4096);
             for k in 0..3 {
                 let want = (a.rho[k] + a.tau[k] + a.rho_spike[k] + a.tau_spike[k]) * background;
                 let rel = (got[k] - want).abs() / want;
@@ -99,7 +99,7 @@ fn white_furnace_holds_for_the_manual2004_variant() {
         for theta in [10.0, 60.0] {
             let v = brtf_model::direction(theta, 0.0);
             let a = albedo(&bsdf, v, 1e-6);
-            let (got, _) = furnace_radiance(Shader::new(&material, &options), v, 1.0, 4096);
+            let (got, _) = furnace_radiance(shader_of(&material, &options), v, 1.0, 4096);
             for k in 0..3 {
                 let want = a.rho[k] + a.tau[k];
                 assert!(
@@ -109,4 +109,52 @@ fn white_furnace_holds_for_the_manual2004_variant() {
             }
         }
     }
+}
+
+/// Lobe sums in the white furnace: the rendered radiance is brtf-model's
+/// `composite_albedo` × L (the weighted sum of the lobes' albedos), for
+/// two isotropic lobes, two anisotropic lobes (fitted orientation and
+/// fixed), three lobes, a mixture of types, a mixture with a mirror
+/// (delta) primitive, and a white two-lobe metal, whose energy stays at
+/// most 1.
+#[test]
+fn white_furnace_holds_for_lobe_sums() {
+    let options = EvalOptions::default();
+    let mut materials = lobe_sums();
+    materials.push(("mirror mixture", mirror_mixture()));
+    materials.push((
+        "white metal ×2",
+        lobe_sum(
+            MaterialKind::Metal,
+            2,
+            false,
+            &[1.0, 1.0, 1.0, 1.0, 0.5, 0.05, 0.3],
+        ),
+    ));
+    let background = 2.0;
+    let mut worst: (f64, String) = (0.0, String::new());
+    let mut most: f64 = 0.0;
+    for (name, composite) in materials {
+        let bsdf = CompositeBsdf::new(&composite, &options);
+        let shader = Shader::new(&composite, &options).unwrap();
+        for theta in [0.0, 40.0, 70.0] {
+            let v = brtf_model::direction(theta, 25.0);
+            let a = composite_albedo(&bsdf, v, 1e-6);
+            let (got, _) = furnace_radiance(shader.clone(), v, background, 4096);
+            for k in 0..3 {
+                let want = (a.rho[k] + a.tau[k] + a.rho_spike[k] + a.tau_spike[k]) * background;
+                let rel = (got[k] - want).abs() / want;
+                if rel > worst.0 {
+                    worst = (rel, format!("{name} θ_v={theta} ch{k}: {got:?} vs {want}"));
+                }
+                most = most.max(got[k] / background);
+            }
+        }
+    }
+    eprintln!(
+        "white furnace, lobe sums: worst relative difference {:.2e} ({}); largest energy {most:.4}",
+        worst.0, worst.1
+    );
+    assert!(worst.0 < 0.01, "{}", worst.1);
+    assert!(most <= 1.0, "a lobe sum reflects {most} of the light");
 }

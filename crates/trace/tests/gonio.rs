@@ -7,8 +7,8 @@
 //!   ([`brtf_trace::cone_average`]) within 1% and within noise.
 //! * Roughness 0: the mirror spike has the analytic height.
 
-use crate::common::{mat, zoo};
-use brtf_model::{Bsdf, EvalOptions, MaterialKind, Rgb, cone_solid_angle};
+use crate::common::{lobe_sums, mat, shader_of, zoo};
+use brtf_model::{Bsdf, CompositeBsdf, EvalOptions, MaterialKind, Rgb, cone_solid_angle};
 use brtf_trace::{GonioSetup, Shader, VirtualGonio, cone_average};
 use glam::DVec3;
 
@@ -83,7 +83,7 @@ fn point_like_apertures_give_the_model_within_noise() {
     let mut tally = Tally::default();
     for (name, material) in zoo() {
         let bsdf = Bsdf::new(&material, &options);
-        let shader = Shader::new(&material, &options);
+        let shader = shader_of(&material, &options);
         for (theta_in, phi_in) in [(0.0, 0.0), (35.0, 20.0), (65.0, 0.0)] {
             let setup = GonioSetup {
                 theta_in,
@@ -130,7 +130,7 @@ fn finite_apertures_give_the_cone_average() {
     let options = EvalOptions::default();
     let mut tally = Tally::default();
     for (name, material) in zoo() {
-        let shader = Shader::new(&material, &options);
+        let shader = shader_of(&material, &options);
         for (theta_in, phi_in) in [(20.0, 0.0), (60.0, 45.0)] {
             let setup = GonioSetup {
                 theta_in,
@@ -184,7 +184,7 @@ fn mirror_spike_of_a_roughness_0_metal_has_the_analytic_height() {
         samples: 64,
         seed: 1,
     };
-    let gonio = VirtualGonio::new(Shader::new(&material, &options), setup);
+    let gonio = VirtualGonio::new(shader_of(&material, &options), setup);
     let mirror = brtf_model::direction(theta_in, 180.0);
     let (values, _) = gonio.render(&[mirror, brtf_model::direction(10.0, 0.0)]);
     // Every detector direction's mirror lies inside the source cone, so
@@ -215,7 +215,7 @@ fn renders_are_deterministic_and_thread_independent() {
         samples: 32,
         seed: 9,
     };
-    let gonio = VirtualGonio::new(Shader::new(&material, &options), setup);
+    let gonio = VirtualGonio::new(shader_of(&material, &options), setup);
     let dirs = directions(material.kind(), 0.0);
     let (a, _) = gonio.render(&dirs);
     let pool = rayon::ThreadPoolBuilder::new()
@@ -274,4 +274,98 @@ fn table_materials_render_with_the_parameters_of_the_incidence() {
             }
         }
     }
+}
+
+/// A lobe sum through the virtual gonio-photometer with a point-like
+/// beam and detector: the rendered BSDF is brtf-model's
+/// `CompositeBsdf::eval` (the weighted sum of the lobes) within the
+/// Monte Carlo error, as for one primitive.
+#[test]
+fn point_like_apertures_give_lobe_sums_within_noise() {
+    let omega = cone_solid_angle(0.01);
+    let options = EvalOptions::default();
+    let mut tally = Tally::default();
+    for (name, composite) in lobe_sums() {
+        let bsdf = CompositeBsdf::new(&composite, &options);
+        let shader = Shader::new(&composite, &options).unwrap();
+        let transmitting = shader.is_transmitting();
+        for (theta_in, phi_in) in [(0.0, 0.0), (35.0, 20.0), (65.0, 0.0)] {
+            let setup = GonioSetup {
+                theta_in,
+                phi_in,
+                source_omega: omega,
+                detector_omega: omega,
+                samples: 256,
+                seed: 11,
+            };
+            let gonio = VirtualGonio::new(shader.clone(), setup);
+            let kind = if transmitting {
+                MaterialKind::Trans
+            } else {
+                MaterialKind::Metal
+            };
+            let dirs = directions(kind, phi_in);
+            let (values, _) = gonio.render(&dirs);
+            let l = setup.light();
+            let model: Vec<Rgb> = dirs.iter().map(|&v| bsdf.eval(l, v)).collect();
+            let peak = model.iter().flatten().fold(0.0f64, |a, &b| a.max(b));
+            for ((v, got), want) in dirs.iter().zip(&values).zip(&model) {
+                tally.add(got.bsdf, got.std_err, *want, peak, 1e-5, &|| {
+                    format!("{name} θ_in={theta_in} v={v:.3}")
+                });
+            }
+        }
+    }
+    eprintln!(
+        "point-like gonio vs lobe sums: {} values, {} beyond 3σ ({:.2}%), {} beyond 5σ, worst relative {:.2e} ({})",
+        tally.values,
+        tally.beyond3,
+        100.0 * tally.beyond3 as f64 / tally.values as f64,
+        tally.beyond5,
+        tally.worst_rel,
+        tally.worst_at
+    );
+    assert!(tally.beyond3 as f64 <= 0.01 * tally.values as f64);
+    assert_eq!(tally.beyond5, 0);
+    assert!(tally.worst_rel < 0.01, "{}", tally.worst_at);
+}
+
+/// With finite (2°) apertures a lobe sum renders as the quadrature cone
+/// average of its shader, within 1% and the noise.
+#[test]
+fn finite_apertures_give_the_cone_average_of_lobe_sums() {
+    let omega = cone_solid_angle(2.0);
+    let options = EvalOptions::default();
+    let mut tally = Tally::default();
+    for (name, composite) in lobe_sums() {
+        let shader = Shader::new(&composite, &options).unwrap();
+        let setup = GonioSetup {
+            theta_in: 40.0,
+            phi_in: 30.0,
+            source_omega: omega,
+            detector_omega: omega,
+            samples: 4096,
+            seed: 5,
+        };
+        let gonio = VirtualGonio::new(shader.clone(), setup);
+        let dirs = directions(MaterialKind::Metal, 30.0);
+        let (values, _) = gonio.render(&dirs);
+        let l = setup.light();
+        let reference: Vec<Rgb> = dirs
+            .iter()
+            .map(|&v| cone_average(&shader, l, omega, v, omega, (8, 16)))
+            .collect();
+        let peak = reference.iter().flatten().fold(0.0f64, |a, &b| a.max(b));
+        for ((v, got), want) in dirs.iter().zip(&values).zip(&reference) {
+            tally.add(got.bsdf, got.std_err, *want, peak, 1e-6, &|| {
+                format!("{name} v={v:.3}")
+            });
+        }
+    }
+    eprintln!(
+        "2° gonio vs cone average, lobe sums: {} values, {} beyond 3σ, worst relative {:.2e} ({})",
+        tally.values, tally.beyond3, tally.worst_rel, tally.worst_at
+    );
+    assert!(tally.worst_rel < 0.01, "{}", tally.worst_at);
+    assert!(tally.beyond3 as f64 <= 0.02 * tally.values as f64);
 }

@@ -1,17 +1,17 @@
 //! Pictures: determinism, the output formats, and a sphere light with a
 //! known answer.
 
-use crate::common::mat;
+use crate::common::{mat, shader_of};
 use brtf_model::{EvalOptions, MaterialKind};
 use brtf_trace::hdr;
-use brtf_trace::{Camera, ImageOptions, Scene, Settings, Shader, Shape, Source, render};
+use brtf_trace::{Camera, ImageOptions, Scene, Settings, Shape, Source, render};
 use brtf_trace::{auto_exposure, write_png};
 use glam::DVec3;
 
 fn scene() -> Scene {
     let mut scene = Scene::new();
     let material = mat(MaterialKind::Plastic, &[0.6, 0.5, 0.4, 0.05, 0.1]);
-    let id = scene.add_shader(Shader::new(&material, &EvalOptions::default()));
+    let id = scene.add_shader(shader_of(&material, &EvalOptions::default()));
     scene.add(
         Shape::Disk {
             center: DVec3::ZERO,
@@ -97,7 +97,7 @@ fn lambertian_floor_under_a_sphere_light() {
     let mut scene = Scene::new();
     let rho = 0.5;
     let material = mat(MaterialKind::Plastic, &[rho, rho, rho, 0.0, 0.0]);
-    let id = scene.add_shader(Shader::new(&material, &EvalOptions::default()));
+    let id = scene.add_shader(shader_of(&material, &EvalOptions::default()));
     scene.add(
         Shape::Disk {
             center: DVec3::ZERO,
@@ -183,7 +183,7 @@ fn direct_rows_equal_the_per_ray_tracer(options: &ImageOptions, glass: bool) {
     // A second, transmitting material lit from behind, and a sphere light.
     let id = if glass {
         let glass = mat(MaterialKind::Trans, &[0.7, 0.8, 0.9, 0.04, 0.05, 0.6, 0.3]);
-        scene.add_shader(Shader::new(&glass, &EvalOptions::default()))
+        scene.add_shader(shader_of(&glass, &EvalOptions::default()))
     } else {
         0
     };

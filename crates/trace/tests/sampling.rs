@@ -9,10 +9,10 @@
 //! than 5 samples are pooled. The test fails if the p-value is below
 //! 0.01/(number of tests).
 
-use crate::common::chi2_p_value;
+use crate::common::{chi2_p_value, lobe_sums};
 use brtf_model::Rng;
 use brtf_model::gauss_legendre_rule as gauss_legendre;
-use brtf_trace::Frame;
+use brtf_trace::{Frame, Shader};
 use brtf_trace::{
     ReflectionLobe, TransmissionLobe, cosine_hemisphere, cosine_hemisphere_pdf, uniform_cone,
     uniform_cone_pdf,
@@ -24,7 +24,7 @@ const SAMPLES: usize = 200_000;
 const NX: usize = 24;
 const NPHI: usize = 16;
 /// Number of chi² tests in this module (for the significance level).
-const TESTS: f64 = 15.0;
+const TESTS: f64 = 19.0;
 
 struct Outcome {
     chi2: f64,
@@ -266,4 +266,35 @@ fn cosine_and_cone_samplers_match_their_pdfs() {
         401,
     );
     check("uniform cone", o, false);
+}
+
+/// The rough lobes of a lobe sum are sampled as a mixture: directions
+/// follow the mixture's density `Σ p_k pdf_k` (which integrates to 1),
+/// for two isotropic lobes and two anisotropic lobes with a fitted
+/// orientation, at a steep and a grazing view.
+#[test]
+fn lobe_sum_mixtures_match_their_pdf() {
+    let options = brtf_model::EvalOptions::default();
+    let sums = lobe_sums();
+    let mut seed = 500;
+    for (name, scale) in [("metal ×2", 0.1), ("plastic2 ×2 oriented", 0.1)] {
+        let (_, composite) = sums.iter().find(|(n, _)| *n == name).unwrap();
+        let shader = Shader::new(composite, &options).unwrap();
+        let (frame, degenerate) = shader.frame(DVec3::Z);
+        for theta in [20.0, 70.0] {
+            let v = frame.to_local(brtf_model::direction(theta, 50.0));
+            let lobes = shader.lobes(v, degenerate).reflect.expect("rough lobes");
+            assert_eq!(lobes.len(), 2, "{name}");
+            seed += 1;
+            let o = chi2_test(
+                |u| lobes.sample(v, u),
+                |l| lobes.pdf(v, l),
+                mirror(v),
+                scale,
+                Some(-v),
+                seed,
+            );
+            check(&format!("{name} mixture θ_v={theta}"), o, true);
+        }
+    }
 }

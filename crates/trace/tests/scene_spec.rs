@@ -4,7 +4,7 @@
 //! moved into brtf-trace), and the gonio-photometer's direction grid and
 //! apertures.
 
-use crate::common::mat;
+use crate::common::{mat, shader_of};
 use brtf_model::{EvalOptions, MaterialKind};
 use brtf_trace::{Aperture, GonioError, GonioSetup, aperture_solid_angle, grid};
 use brtf_trace::{BALL_CENTER, FLOOR_RADIUS};
@@ -14,7 +14,7 @@ use brtf_trace::{
 
 fn shader() -> Shader {
     let m = mat(MaterialKind::Plastic, &[0.6, 0.5, 0.4, 0.05, 0.1]);
-    Shader::new(&m, &EvalOptions::default())
+    shader_of(&m, &EvalOptions::default())
 }
 
 /// The defaults at 16 × 12 pixels.

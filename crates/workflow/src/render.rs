@@ -4,7 +4,7 @@
 use crate::WorkflowError;
 use brtf_fit::FitResult;
 use brtf_gonio::{Channels, Measurement, SourceFormat};
-use brtf_model::{EvalOptions, Material, Variant};
+use brtf_model::{Composite, EvalOptions, Material, Variant};
 use brtf_trace::Shader;
 use brtf_trace::{GonioSetup, GonioValue, RayCounts, SceneSpec, VirtualGonio};
 use std::path::{Path, PathBuf};
@@ -33,16 +33,37 @@ pub enum MaterialSource {
 pub struct RenderMaterial {
     /// What the tracer evaluates.
     pub shader: Shader,
-    /// The one static material (the fit's all-incidence set, or the file's).
-    pub material: Material,
+    /// The static material, one primitive or a lobe sum (the fit's
+    /// all-incidence set, or the file's).
+    pub material: Composite,
     /// Its name.
     pub name: String,
     /// The fit, when the material came from one.
     pub fit: Option<FitResult>,
 }
 
-/// Loads `source` for the tracer. `variant` and `fresnel_k` override the
-/// fit's (default: radiance and the classic constant for a file).
+/// What the `.rad` reader gives, as a [`Composite`] (one primitive or a
+/// constant `mixfunc` tree of them).
+trait IntoComposite {
+    fn into_composite(self) -> Composite;
+}
+
+impl IntoComposite for Material {
+    fn into_composite(self) -> Composite {
+        Composite::from_material(&self)
+    }
+}
+
+impl IntoComposite for Composite {
+    fn into_composite(self) -> Composite {
+        self
+    }
+}
+
+/// Loads `source` for the tracer: a fit folder of any shape (one
+/// primitive, a lobe sum, a fitted orientation) or a `.rad` material.
+/// `variant` and `fresnel_k` override the fit's (default: radiance and
+/// the classic constant for a file).
 pub fn load_render_material(
     source: &MaterialSource,
     variant: Option<Variant>,
@@ -51,11 +72,16 @@ pub fn load_render_material(
     let (name, material, fit, mut options) = match source {
         MaterialSource::File { path, name } => {
             let (name, material) = crate::read_material_file(path, name.as_deref())?;
-            (name, material, None, EvalOptions::default())
+            (
+                name,
+                material.into_composite(),
+                None,
+                EvalOptions::default(),
+            )
         }
         MaterialSource::Fit { dir, .. } => {
             let fit = crate::read_fit(dir)?;
-            let material = fit.static_material().ok_or_else(|| {
+            let material = fit.static_composite().ok_or_else(|| {
                 WorkflowError::Usage(format!(
                     "{}: the fit holds no valid material",
                     dir.display()
@@ -74,7 +100,7 @@ pub fn load_render_material(
     };
     let shader = match table {
         Some(table) => Shader::from_table(table, &options)?,
-        None => Shader::new(&material, &options),
+        None => Shader::new(&material, &options)?,
     };
     Ok(RenderMaterial {
         shader,
@@ -165,7 +191,7 @@ pub fn render_gonio(
         Some(m) => m.samples.iter().map(|s| (s.theta_deg, s.phi_deg)).collect(),
         None => {
             let [dt, dp] = request.grid_steps;
-            let back = request.back || material.material.kind().is_transmitting();
+            let back = request.back || material.shader.is_transmitting();
             brtf_trace::grid(dt, dp, back)?
         }
     };
@@ -287,6 +313,24 @@ pub fn render_image(
             "a number above 0",
         )?;
     }
+    // The static material as Radiance text, for `--radiance`.
+    let primitive_text = match (request.radiance, material.material.single()) {
+        (false, _) => None,
+        (true, Some(m)) => Some(brtf_radiance::format_primitive(
+            &brtf_radiance::primitive_from_material(m, brtf_trace::MATERIAL_NAME),
+        )),
+        (true, None) => {
+            let shape = material
+                .material
+                .shape()
+                .map_or_else(|| "a mixture".to_string(), |s| s.label());
+            return Err(WorkflowError::Usage(format!(
+                "--radiance writes one Radiance primitive, and {} is a lobe sum ({shape}); \
+                 render it without --radiance (brtf-trace renders lobe sums)",
+                material.name
+            )));
+        }
+    };
     let inputs: Vec<&Path> = material_file.into_iter().collect();
     for ext in [".hdr", ".png", ".rad", ".vf"] {
         brtf_io::check_overwrite(&with_extension(prefix, ext), &inputs, None, false)?;
@@ -316,14 +360,12 @@ pub fn render_image(
         (with_extension(prefix, ".png"), png),
     ];
     let mut notes = Vec::new();
-    if request.radiance {
-        let primitive =
-            brtf_radiance::primitive_from_material(&material.material, brtf_trace::MATERIAL_NAME);
+    if let Some(primitive) = primitive_text {
         let name = prefix
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_default();
-        let rad = spec.radiance_text(&brtf_radiance::format_primitive(&primitive), &name);
+        let rad = spec.radiance_text(&primitive, &name);
         written.push((with_extension(prefix, ".rad"), rad.into_bytes()));
         written.push((
             with_extension(prefix, ".vf"),
