@@ -17,6 +17,7 @@ mod fit;
 mod info;
 mod klems_export;
 mod klems_fit;
+mod lobe_render;
 mod many;
 mod peer;
 mod plot;
