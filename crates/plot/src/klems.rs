@@ -10,7 +10,7 @@
 use crate::colour::diverging;
 use crate::report::esc;
 use brtf_fit::{FitResult, PreparedMeasurement};
-use brtf_model::Bsdf;
+use brtf_model::CompositeBsdf;
 use std::fmt::Write;
 use std::path::Path;
 
@@ -50,9 +50,9 @@ fn rows(result: &FitResult, fit_dir: &Path) -> Result<Vec<PatchRow>, String> {
         let prepared = brtf_fit::prepare_input(&result.recipe, input, bytes, path)
             .map_err(|e| e.to_string())?;
         let material = result
-            .material_of(report)
+            .composite_of(report)
             .ok_or_else(|| format!("{}: the fitted arguments are not a material", input.label()))?;
-        let bsdf = Bsdf::new(&material, &result.options());
+        let bsdf = CompositeBsdf::new(&material, &result.options());
         rows.push(row(&prepared, &bsdf, report.scale, at.patch, report));
     }
     Ok(rows)
@@ -68,7 +68,7 @@ fn luminance(values: [f64; 3], channels: usize) -> f64 {
 
 fn row(
     prepared: &PreparedMeasurement,
-    bsdf: &Bsdf,
+    bsdf: &CompositeBsdf,
     scale: f64,
     patch: usize,
     report: &brtf_fit::FitReport,
@@ -85,7 +85,7 @@ fn row(
     let per_block = m.samples.iter().filter(|s| s.theta_deg <= 90.0).count();
     for (i, s) in m.samples.iter().enumerate() {
         let data = luminance(s.values, channels);
-        let model = scale * luminance(prepared.model_value(bsdf, i), channels);
+        let model = scale * luminance(crate::prepare::model_value(prepared, bsdf, i), channels);
         // Λ = dΩ · cos θ_centre.
         let lambda = s.solid_angle_sr.unwrap_or(0.0) * s.abs_cos_theta();
         let totals = if s.theta_deg > 90.0 {

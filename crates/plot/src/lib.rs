@@ -401,7 +401,8 @@ fn plot(
     );
     let channels = incs.first().map_or(1, |i| i.channels);
     let name = &result.name;
-    let model = result.config.kind.name();
+    // The type, or the lobe sum's label (`metal ×2 lobes`).
+    let model = result.config.shape().label();
 
     let mut jobs: Vec<Job> = Vec::new();
     for inc in &incs {

@@ -20,7 +20,7 @@ use crate::disk::{self, Coverage};
 pub(crate) use brtf_fit::{DataUnit, Gate};
 use brtf_fit::{FitReport, FitResult, InputFile, PreparedMeasurement, Recipe};
 use brtf_gonio::Hemisphere;
-use brtf_model::Bsdf;
+use brtf_model::CompositeBsdf;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -80,8 +80,9 @@ pub struct Incidence {
     pub unit: DataUnit,
     /// The floor of relative residuals and log ratios (the report's).
     pub floor: f64,
-    /// The fitted material, prepared for evaluation.
-    pub bsdf: Bsdf,
+    /// The fitted material (one primitive or a lobe sum), prepared for
+    /// evaluation.
+    pub bsdf: CompositeBsdf,
     /// The free scale (1 when not fitted).
     pub scale: f64,
     /// Channels in the file (1 or 3); plotted values are their mean.
@@ -350,6 +351,27 @@ fn disk_grid(
     )
 }
 
+/// The model value the fit compares with sample `index` of `prepared`
+/// ([`PreparedMeasurement::model_value`]) for a lobe sum: its lobes'
+/// values weighted (one lobe: that lobe's value as it is).
+pub(crate) fn model_value(
+    prepared: &PreparedMeasurement,
+    bsdf: &CompositeBsdf,
+    index: usize,
+) -> [f64; 3] {
+    if let [(_, lobe)] = bsdf.parts() {
+        return prepared.model_value(lobe, index);
+    }
+    let mut sum = [0.0; 3];
+    for (w, lobe) in bsdf.parts() {
+        let f = prepared.model_value(lobe, index);
+        for (s, v) in sum.iter_mut().zip(f) {
+            *s += w * v;
+        }
+    }
+    sum
+}
+
 /// `ln((model + floor)/(data + floor))`, data clamped at 0.
 fn log_ratio(data: f64, model: f64, floor: f64) -> f64 {
     ((model.max(0.0) + floor) / (data.max(0.0) + floor)).ln()
@@ -419,9 +441,9 @@ fn build(
     let channels = prepared.channels();
     let unit = prepared.conversion.unit();
     let material = result
-        .material_of(report)
+        .composite_of(report)
         .ok_or_else(|| format!("{}: the fitted arguments are not a material", input.path))?;
-    let bsdf = Bsdf::new(&material, &result.options());
+    let bsdf = CompositeBsdf::new(&material, &result.options());
     let light = brtf_model::direction(report.theta_in, report.phi_in);
     let gates: Vec<Gate> = result.recipe.selections.clone();
     let removed_by = &prepared.removed_by;
@@ -464,7 +486,7 @@ fn build(
                 Some(_) => {
                     values.resize(0);
                     for k in 0..block.len() {
-                        let f = prepared.model_value(&bsdf, b * BLOCK + k);
+                        let f = model_value(prepared, &bsdf, b * BLOCK + k);
                         values.r.push(f[0]);
                         values.g.push(f[1]);
                         values.b.push(f[2]);

@@ -99,6 +99,11 @@ pre { background: #f6f6f6; border: 1px solid #ddd; padding: 10px; overflow-x: au
 code { font-size: 0.95em; }
 "#;
 
+/// The styles of the `--model auto` table (only in reports that have it).
+const AUTO_STYLE: &str = "tr.chosen td { background: #eaf6ea; font-weight: 600; }
+tr.other td { color: #777; }
+";
+
 fn figure(out: &mut String, stem: &str, size: (u32, u32), caption: &str) {
     let svg = href(&format!("plots/{stem}.svg"));
     let png = href(&format!("plots/{stem}.png"));
@@ -157,7 +162,9 @@ fn param_table(out: &mut String, result: &FitResult) {
     for n in &names {
         let _ = write!(out, "<th>{}</th>", esc(n));
     }
-    out.push_str("<th>RMS rel.</th><th class=\"l\">termination</th></tr></thead><tbody>\n");
+    out.push_str(
+        "<th>E1</th><th>RMS rel.</th><th class=\"l\">termination</th></tr></thead><tbody>\n",
+    );
     let mut row = |r: &FitReport, label: String, phi: String, class: &str| {
         let _ = write!(
             out,
@@ -169,7 +176,8 @@ fn param_table(out: &mut String, result: &FitResult) {
         }
         let _ = writeln!(
             out,
-            "<td>{}</td><td class=\"l\">{}</td></tr>",
+            "<td class=\"e1\">{}</td><td>{}</td><td class=\"l\">{}</td></tr>",
+            r.e1.map_or_else(|| "–".to_string(), percent),
             fmt(r.rms_rel),
             esc(r.termination.label())
         );
@@ -186,7 +194,147 @@ fn param_table(out: &mut String, result: &FitResult) {
          sandwich (heteroscedasticity-consistent) one; \
          <span class=\"bound\">at bound</span> = ended at a physical bound (no standard error); \
          “all” = one parameter set fitted to every incidence at once. \
+         E1 = Σ ω |model − data| ÷ Σ ω |data| over the fitted samples (ω their weights): \
+         the share of the measured light the material puts in the wrong place. \
          RMS rel. = RMS of (model − data) ÷ √(data² + floor²).</p>\n",
+    );
+    lobe_note(out, result);
+}
+
+/// A percentage of a fraction (E1), two decimals.
+fn percent(fraction: f64) -> String {
+    format!("{:.2}%", 100.0 * fraction)
+}
+
+/// What a lobe sum's or a fitted orientation's parameters mean, with the
+/// static material's lobe weights (nothing for one primitive).
+fn lobe_note(out: &mut String, result: &FitResult) {
+    let shape = result.config.shape();
+    if shape.is_single() {
+        return;
+    }
+    let mut parts = Vec::new();
+    if shape.lobes > 1 {
+        let weights = result
+            .static_composite()
+            .map(|m| {
+                m.components()
+                    .iter()
+                    .map(|(w, _)| format!("{w:.4}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            })
+            .unwrap_or_else(|| "–".into());
+        parts.push(format!(
+            "{} specular lobes of <code>{}</code> over one diffuse base, sharing colour and \
+             <code>spec</code>; lobe k has the roughness numbered k and the weight \
+             split<sub>k</sub> × Π<sub>j&lt;k</sub> (1 − split<sub>j</sub>) (the last lobe what is \
+             left), lobes ordered from the sharpest; the weights of the {} are {}",
+            shape.lobes,
+            esc(shape.kind.name()),
+            if result.global.is_some() {
+                "all-incidence fit"
+            } else {
+                "first incidence's fit"
+            },
+            weights
+        ));
+    }
+    if shape.oriented {
+        parts.push(
+            "<code>orient</code> is the fitted angle in degrees, in the surface plane from +x \
+             towards +y, of the anisotropic types' u direction"
+                .to_string(),
+        );
+    }
+    let _ = writeln!(
+        out,
+        "<p class=\"muted\" id=\"lobes\">{}: {}.</p>",
+        esc(&shape.label()),
+        parts.join("; ")
+    );
+}
+
+/// The candidates of `--model auto`, the chosen one marked, and why.
+fn auto_section(out: &mut String, auto: &brtf_fit::AutoChoice) {
+    out.push_str(
+        "<section id=\"auto\"><h2>Model choice (<code>--model auto</code>)</h2>\n\
+         <table id=\"auto-table\"><thead><tr><th class=\"l\"></th><th class=\"l\">model</th>\
+         <th>parameters</th><th>E1</th><th>held-out E1</th><th>peak offset [°]</th><th>cost</th>\
+         <th>time [ms]</th><th class=\"l\">collapsed</th></tr></thead><tbody>\n",
+    );
+    for (i, c) in auto.candidates.iter().enumerate() {
+        let (class, mark) = if i == auto.chosen {
+            ("chosen", "✔ chosen")
+        } else if i < auto.first {
+            ("other", "not a candidate")
+        } else {
+            ("candidate", "")
+        };
+        let _ = writeln!(
+            out,
+            "<tr class=\"{class}\"><td class=\"l\">{mark}</td><td class=\"l\">{}</td><td>{}</td>\
+             <td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{:.0}</td><td class=\"l\">{}</td></tr>",
+            esc(&c.model),
+            c.parameters,
+            percent(c.e1),
+            percent(c.e1_heldout),
+            c.peak_offset_deg
+                .map_or_else(|| "–".to_string(), |p| format!("{p:.1}")),
+            fmt(c.cost),
+            c.elapsed_ms,
+            if c.collapsed { "collapsed" } else { "–" }
+        );
+    }
+    out.push_str("</tbody></table>\n");
+    let _ = writeln!(
+        out,
+        "<p id=\"auto-reason\">Chosen: {}</p>\n<p class=\"muted\">held-out E1: every \
+         incidence's samples dealt into {} folds, each fold fitted again without its samples and \
+         judged on them. Parameters are counted per incidence. “not a candidate”: the other \
+         family's one-lobe fit, which decided between plastic and metal.</p>\n</section>",
+        esc(&auto.reason),
+        brtf_fit::FOLDS
+    );
+}
+
+/// The headline figure under the title: E1 of the all-incidence fit and
+/// the range over the incidences (nothing when the fit has no E1).
+fn e1_headline(out: &mut String, result: &FitResult) {
+    let per: Vec<f64> = result.incidences.iter().filter_map(|r| r.e1).collect();
+    let global = result
+        .global
+        .as_ref()
+        .filter(|_| result.incidences.len() > 1)
+        .and_then(|g| g.e1);
+    if per.is_empty() && global.is_none() {
+        return;
+    }
+    let mut parts = Vec::new();
+    if let Some(g) = global {
+        parts.push(format!(
+            "<strong>{}</strong> for the all-incidence fit",
+            percent(g)
+        ));
+    }
+    if !per.is_empty() {
+        let lo = per.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = per.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        parts.push(if per.len() == 1 || lo == hi {
+            format!("<strong>{}</strong> per incidence", percent(lo))
+        } else {
+            format!(
+                "<strong>{}</strong> to <strong>{}</strong> per incidence",
+                percent(lo),
+                percent(hi)
+            )
+        });
+    }
+    let _ = writeln!(
+        out,
+        "<p id=\"headline\">E1 {}: the share of the measured light the material puts in the \
+         wrong place.</p>",
+        parts.join(", ")
     );
 }
 
@@ -280,7 +428,7 @@ fn provenance_section(out: &mut String, dir: &Path, result: &FitResult) {
          <tr><th class=\"l\">θ_in interpolation</th><td class=\"l\">{:?}</td></tr>\
          <tr><th class=\"l\">selections</th><td class=\"l\">{}</td></tr>\
          </tbody></table>",
-        esc(c.kind.name()),
+        esc(&c.shape().label()),
         esc(c.options.variant.name()),
         c.options.fresnel_k,
         c.options.source_omega,
@@ -318,23 +466,35 @@ pub(crate) fn html(input: &ReportInput) -> String {
         out,
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
          <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n\
-         <link rel=\"icon\" href=\"data:,\">\n<title>{}</title>\n<style>{STYLE}</style>\n</head>\n<body>\n",
-        esc(&title)
+         <link rel=\"icon\" href=\"data:,\">\n<title>{}</title>\n<style>{STYLE}{}</style>\n</head>\n<body>\n",
+        esc(&title),
+        if result.auto.is_some() {
+            AUTO_STYLE
+        } else {
+            ""
+        }
     );
     let _ = writeln!(out, "<h1>{}</h1>", esc(&title));
     let _ = writeln!(
         out,
         "<p class=\"muted\">Radiance <code>{}</code> ({} variant) fitted to {} incidence(s); made {} by brtf {}.</p>",
-        esc(result.config.kind.name()),
+        esc(&result.config.shape().label()),
         esc(result.config.options.variant.name()),
         result.incidences.len(),
         esc(&result.provenance.created),
         esc(&result.provenance.brtf_version)
     );
-    out.push_str(
-        "<nav><a href=\"#parameters\">Parameters</a><a href=\"#theta\">Over θ_in</a>\
+    e1_headline(&mut out, result);
+    let auto_link = if result.auto.is_some() {
+        "<a href=\"#auto\">Model choice</a>"
+    } else {
+        ""
+    };
+    let _ = writeln!(
+        out,
+        "<nav><a href=\"#parameters\">Parameters</a>{auto_link}<a href=\"#theta\">Over θ_in</a>\
          <a href=\"#incidences\">Per incidence</a><a href=\"#material\">Material</a>\
-         <a href=\"#provenance\">Provenance</a></nav>\n",
+         <a href=\"#provenance\">Provenance</a></nav>",
     );
 
     // With one incidence the all-incidence fit is that fit: its warnings
@@ -364,6 +524,9 @@ pub(crate) fn html(input: &ReportInput) -> String {
     out.push_str("<section id=\"parameters\"><h2>Parameters</h2>\n");
     param_table(&mut out, result);
     out.push_str("</section>\n");
+    if let Some(auto) = &result.auto {
+        auto_section(&mut out, auto);
+    }
 
     out.push_str("<section id=\"theta\"><h2>Over θ_in</h2>\n");
     for (stem, size, caption) in &input.overview {
@@ -396,6 +559,9 @@ pub(crate) fn html(input: &ReportInput) -> String {
             r.n_points,
             fmt(r.rms_rel)
         );
+        if let Some(e1) = r.e1 {
+            let _ = write!(out, ", E1 {}", percent(e1));
+        }
         if !r.gates.is_empty() {
             let gates: Vec<String> = r
                 .gates

@@ -7,4 +7,5 @@
 mod common;
 
 mod charts;
+mod lobes;
 mod report;

@@ -54,7 +54,7 @@ fn the_report_shows_the_table_material_and_provenance() {
         d.result.incidences.len()
     );
     assert_eq!(table.matches("<tr class=\"global\">").count(), 1);
-    for name in ["red", "green", "blue", "spec", "rough", "RMS rel."] {
+    for name in ["red", "green", "blue", "spec", "rough", "E1", "RMS rel."] {
         assert!(table.contains(&format!("<th>{name}</th>")), "column {name}");
     }
     let rough = d.result.incidences[2].value("rough").unwrap();

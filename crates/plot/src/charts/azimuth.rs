@@ -41,7 +41,10 @@ impl AzimuthChart<'_> {
     /// `(argument index, axis title)` of each panel: the free parameters,
     /// one colour panel when grey.
     fn panels(&self) -> Vec<(usize, String)> {
-        let names = self.result.config.kind.param_names();
+        let Some(table) = &self.result.table else {
+            return Vec::new();
+        };
+        let names = table.shape().param_names();
         let rings = self.rings();
         let varies = |j: usize| {
             rings
@@ -59,6 +62,8 @@ impl AzimuthChart<'_> {
             .map(|(j, name)| {
                 let title = if grey && j == 0 {
                     "colour (red = green = blue) [–]".to_string()
+                } else if name == "orient" {
+                    "orient: orientation of u from +x [°]".to_string()
                 } else {
                     format!("{name} [–]")
                 };

@@ -8,8 +8,8 @@
 //! the pixels of the map's equal-area grid ([`crate::disk::Coverage`]).
 //! The model's is the same integral of the model values at the same
 //! samples, so the two see the same gaps and masks; and the model's full
-//! integral over the hemisphere (brtf-model's [`brtf_model::albedo`]) is
-//! what a renderer will reflect. τ_dh is the same over the back hemisphere.
+//! integral over the hemisphere (brtf-model's [`brtf_model::composite_albedo`],
+//! the lobes' integrals weighted) is what a renderer will reflect. τ_dh is the same over the back hemisphere.
 
 use super::{
     CartesianChart, Frame, TICK, legend_circle, legend_dashes, legend_line, legend_triangle,
@@ -20,7 +20,7 @@ use crate::figure::{Area, Canvas, Chart, OrMsg};
 use crate::prepare::{DataUnit, Incidence};
 use brtf_fit::{FitReport, FitResult, Interpolation};
 use brtf_gonio::Hemisphere;
-use brtf_model::{Bsdf, Material};
+use brtf_model::{Composite, CompositeBsdf};
 use plotters::coord::types::RangedCoordf64;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
@@ -51,18 +51,20 @@ fn theta_axes<'a, DB: DrawingBackend>(
     Ok(chart)
 }
 
-/// Model ρ_dh and τ_dh (non-delta + delta parts) of `material` for light
-/// from (θ, φ), channel mean over `channels`, times `scale`.
+/// Model ρ_dh and τ_dh (non-delta + delta parts) of `material` (one
+/// primitive or a lobe sum) for light from (θ, φ), channel mean over
+/// `channels`, times `scale`.
 pub(crate) fn model_integrals(
-    material: &Material,
+    material: &Composite,
     result: &FitResult,
     theta: f64,
     phi: f64,
     scale: f64,
     channels: usize,
 ) -> [f64; 2] {
-    let bsdf = Bsdf::new(material, &result.options());
-    let a = brtf_model::albedo(&bsdf, brtf_model::direction(theta, phi), ALBEDO_TOLERANCE);
+    let bsdf = CompositeBsdf::new(material, &result.options());
+    let a =
+        brtf_model::composite_albedo(&bsdf, brtf_model::direction(theta, phi), ALBEDO_TOLERANCE);
     let mean = |x: [f64; 3], y: [f64; 3]| {
         (0..channels).map(|c| x[c] + y[c]).sum::<f64>() / channels as f64 * scale
     };
@@ -90,7 +92,7 @@ pub(crate) fn integrals(result: &FitResult, incs: &[Option<&Incidence>]) -> Vec<
         .zip(incs)
         .map(|(report, inc)| {
             let channels = inc.map_or(1, |i| i.channels);
-            let model_full = result.material_of(report).map_or([f64::NAN; 2], |m| {
+            let model_full = result.composite_of(report).map_or([f64::NAN; 2], |m| {
                 model_integrals(
                     &m,
                     result,
@@ -142,6 +144,36 @@ struct Panel {
     y_desc: String,
     /// `(legend name, parameter name, colour)`.
     series: Vec<(String, String, RGBColor)>,
+}
+
+/// The axis title of parameter `name` (a flat argument of any shape, or
+/// `scale`), with its unit.
+fn axis_title(name: &str, unit: &DataUnit) -> String {
+    // A lobe sum numbers its lobes' arguments: `rough2`, `rough_u1`, `split1`.
+    let digits = name.trim_start_matches(|c: char| !c.is_ascii_digit());
+    let (base, lobe) = match digits.parse::<usize>() {
+        Ok(k) if !digits.is_empty() => (&name[..name.len() - digits.len()], Some(k)),
+        _ => (name, None),
+    };
+    match (base, lobe) {
+        ("spec", None) => "spec: specularity [–]".to_string(),
+        ("rough", None) => "rough: roughness (RMS slope) [–]".into(),
+        ("rough_u", None) => "rough_u: roughness along u [–]".into(),
+        ("rough_v", None) => "rough_v: roughness along v [–]".into(),
+        ("rough", Some(k)) => format!("{name}: roughness of lobe {k} [–]"),
+        ("rough_u", Some(k)) => format!("{name}: lobe {k}'s roughness along u [–]"),
+        ("rough_v", Some(k)) => format!("{name}: lobe {k}'s roughness along v [–]"),
+        ("split", Some(1)) => format!("{name}: lobe 1's share of the lobes [–]"),
+        ("split", Some(k)) => format!("{name}: lobe {k}'s share of the rest [–]"),
+        ("trans", None) => "trans: transmissivity [–]".into(),
+        ("tspec", None) => "tspec: transmitted specular fraction [–]".into(),
+        ("orient", None) => "orient: orientation of u from +x [°]".into(),
+        ("scale", None) => match unit {
+            DataUnit::RawPerCos(u) => format!("scale: free scale [{u}·sr]"),
+            DataUnit::Bsdf => "scale: free scale [–]".into(),
+        },
+        _ => format!("{name} [–]"),
+    }
 }
 
 /// Parameters over θ_in, one panel per parameter (colour channels share one).
@@ -196,21 +228,8 @@ impl ParamsChart<'_> {
             .iter()
             .filter(|p| !p.fixed && !["red", "green", "blue"].contains(&p.name.as_str()))
         {
-            let y_desc = match p.name.as_str() {
-                "spec" => "spec: specularity [–]".to_string(),
-                "rough" => "rough: roughness (RMS slope) [–]".into(),
-                "rough_u" => "rough_u: roughness along u [–]".into(),
-                "rough_v" => "rough_v: roughness along v [–]".into(),
-                "trans" => "trans: transmissivity [–]".into(),
-                "tspec" => "tspec: transmitted specular fraction [–]".into(),
-                "scale" => match &self.unit {
-                    DataUnit::RawPerCos(u) => format!("scale: free scale [{u}·sr]"),
-                    DataUnit::Bsdf => "scale: free scale [–]".into(),
-                },
-                other => format!("{other} [–]"),
-            };
             panels.push(Panel {
-                y_desc,
+                y_desc: axis_title(&p.name, &self.unit),
                 series: vec![(p.name.clone(), p.name.clone(), DATA)],
             });
         }
@@ -226,15 +245,13 @@ impl ParamsChart<'_> {
         let result = self.result;
         let thetas: Vec<f64> = result.incidences.iter().map(|r| r.theta_in).collect();
         let (x0, x1) = theta_range(&thetas);
-        let param = |r: &FitReport, name: &str| r.params.iter().find(|p| p.name == name).cloned();
-        let curve = |name: &str| -> Option<Vec<(f64, f64)>> {
+        let column = |name: &str| {
             let table = result.table.as_ref()?;
-            let j = result
-                .config
-                .kind
-                .param_names()
-                .iter()
-                .position(|n| *n == name)?;
+            let j = table.shape().param_names().iter().position(|n| n == name)?;
+            Some((table, j))
+        };
+        let curve = |name: &str| -> Option<Vec<(f64, f64)>> {
+            let (table, j) = column(name)?;
             let (lo, hi) = table.range();
             Some(
                 (0..=CURVE_STEPS)
@@ -244,6 +261,27 @@ impl ParamsChart<'_> {
                     })
                     .collect(),
             )
+        };
+        // A fitted orientation is an angle modulo 180°, which the θ_in
+        // table unwraps: each fit's is drawn on the table's branch (at its
+        // θ_in; the all-incidence fit's nearest the table's mean).
+        let orient_reference = |r: &FitReport| -> Option<f64> {
+            let (table, j) = column("orient")?;
+            if result.global.as_ref().is_some_and(|g| std::ptr::eq(g, r)) {
+                let line = curve("orient")?;
+                Some(line.iter().map(|p| p.1).sum::<f64>() / line.len() as f64)
+            } else {
+                Some(table.args_at(r.theta_in).0[j])
+            }
+        };
+        let param = |r: &FitReport, name: &str| {
+            let mut p = r.params.iter().find(|p| p.name == name).cloned()?;
+            if name == "orient"
+                && let Some(reference) = orient_reference(r)
+            {
+                p.value += 180.0 * ((reference - p.value) / 180.0).round();
+            }
+            Some(p)
         };
         let mut ys = Vec::new();
         for (_, name, _) in &panel.series {
@@ -482,17 +520,15 @@ impl RhoChart<'_> {
         let global = result
             .global
             .as_ref()
-            .and_then(|g| result.material_of(g).map(|m| (m, g.scale)));
+            .and_then(|g| result.composite_of(g).map(|m| (m, g.scale)));
         (0..=CURVE_STEPS)
             .map(|k| {
                 let t = lo + (hi - lo) * k as f64 / CURVE_STEPS as f64;
                 let table = result
                     .table
                     .as_ref()
-                    .and_then(|tab| tab.at(t).ok())
-                    .map(|l| {
-                        model_integrals(&l.material, result, t, phi, scale_at(t), self.channels)
-                    });
+                    .and_then(|tab| tab.composite_at(t).ok())
+                    .map(|(m, _)| model_integrals(&m, result, t, phi, scale_at(t), self.channels));
                 let g = global
                     .as_ref()
                     .map(|(m, s)| model_integrals(m, result, t, phi, *s, self.channels));
