@@ -1,7 +1,8 @@
 //! Direct-light pictures a row at a time, in structure-of-arrays form.
 //!
 //! When a picture has no specular, diffuse or delta rays and every shader
-//! is one isotropic material ([`Tracer::direct_batch_applies`]), a camera
+//! is one isotropic material, one primitive or a lobe sum
+//! ([`Tracer::direct_batch_applies`]), a camera
 //! ray's radiance is its first hit's direct term alone. Then a whole row
 //! goes through the same stages together: camera rays, nearest hits (one
 //! primitive against all rays at a time), shading frames, source samples,
@@ -435,6 +436,9 @@ pub(crate) struct DirectRows {
     gather_l: brtf_model::Directions,
     gather_v: brtf_model::Directions,
     gather_f: brtf_model::RgbBatch,
+    /// One lobe's values of a lobe sum.
+    part: Vectors,
+    gather_part: brtf_model::RgbBatch,
 }
 
 impl DirectRows {
@@ -793,14 +797,16 @@ impl DirectRows {
     }
 
     /// `f` of every (light, view) pair: per block of source samples, one
-    /// batch evaluation per shader (gathered when the scene has several).
+    /// batch evaluation per shader (gathered when the scene has several),
+    /// and per lobe of a lobe sum, added up with its weight in the
+    /// per-ray tracer's order.
     fn evaluate(&mut self, tracer: &Tracer, blocks: usize, hits: usize) {
         let scene = tracer.scene;
         let single = scene.shaders.len() == 1;
         for b in 0..blocks {
             let range = b * hits..(b + 1) * hits;
             if single {
-                let bsdf = scene.shaders[0].single_bsdf().expect("one material");
+                let shader = &scene.shaders[0];
                 let l = [
                     &self.lights.x[range.clone()],
                     &self.lights.y[range.clone()],
@@ -812,15 +818,30 @@ impl DirectRows {
                     &self.views.z[..hits],
                 ];
                 let (fx, fy, fz) = (&mut self.f.x, &mut self.f.y, &mut self.f.z);
-                bsdf.eval_soa(
-                    l,
-                    v,
-                    [
-                        &mut fx[range.clone()],
-                        &mut fy[range.clone()],
-                        &mut fz[range.clone()],
-                    ],
-                );
+                let f = [
+                    &mut fx[range.clone()],
+                    &mut fy[range.clone()],
+                    &mut fz[range.clone()],
+                ];
+                if let Some(bsdf) = shader.single_bsdf() {
+                    bsdf.eval_soa(l, v, f);
+                    continue;
+                }
+                for c in f {
+                    c.fill(0.0);
+                }
+                self.part.resize(hits);
+                for (w, bsdf) in shader.part_bsdfs().expect("one material") {
+                    bsdf.eval_soa(l, v, self.part.xyz_mut(hits));
+                    for (c, part) in [(&mut *fx, &self.part.x), (&mut *fy, &self.part.y)]
+                        .into_iter()
+                        .chain([(&mut *fz, &self.part.z)])
+                    {
+                        for (x, y) in c[range.clone()].iter_mut().zip(&part[..hits]) {
+                            *x += w * y;
+                        }
+                    }
+                }
                 continue;
             }
             for (shader_index, shader) in scene.shaders.iter().enumerate() {
@@ -838,8 +859,18 @@ impl DirectRows {
                 if self.gather_index.is_empty() {
                     continue;
                 }
-                let bsdf = shader.single_bsdf().expect("one material");
-                bsdf.eval_batch(&self.gather_l, &self.gather_v, &mut self.gather_f);
+                match shader.single_bsdf() {
+                    Some(bsdf) => {
+                        bsdf.eval_batch(&self.gather_l, &self.gather_v, &mut self.gather_f)
+                    }
+                    None => {
+                        self.gather_f.resize(self.gather_index.len());
+                        for (w, bsdf) in shader.part_bsdfs().expect("one material") {
+                            bsdf.eval_batch(&self.gather_l, &self.gather_v, &mut self.gather_part);
+                            self.gather_f.add_scaled(w, &self.gather_part);
+                        }
+                    }
+                }
                 for (g, &k) in self.gather_index.iter().enumerate() {
                     let f = self.gather_f.get(g);
                     self.f.set(k, DVec3::from_array(f));

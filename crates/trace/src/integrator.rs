@@ -428,7 +428,7 @@ impl<'a> Tracer<'a> {
 impl Tracer<'_> {
     /// True when every camera ray's radiance is its first hit's direct
     /// term alone (no specular, diffuse or delta rays) and every shader
-    /// is one isotropic material, so that the row pipeline of
+    /// is one isotropic material (one primitive or a lobe sum), so that the row pipeline of
     /// [`crate::direct`] gives what [`Self::radiance`] gives (to the
     /// last bits of the batch BSDF, 1e-15 relative).
     pub(crate) fn direct_batch_applies(&self) -> bool {
@@ -436,7 +436,7 @@ impl Tracer<'_> {
         let no_rays = (s.specular_samples == 0 || s.max_depth == 0) && s.diffuse_samples == 0;
         no_rays
             && self.scene.shaders.iter().all(|shader| {
-                !shader.has_delta() && shader.single_bsdf().is_some() && !shader.is_anisotropic()
+                !shader.has_delta() && shader.part_bsdfs().is_some() && !shader.is_anisotropic()
             })
     }
 

@@ -557,6 +557,15 @@ impl Shader {
         }
     }
 
+    /// The primitives of a single-material shader with their weights
+    /// (`None` for a table), for batch evaluation: [`Self::eval`] with
+    /// `degenerate = false` is `Σ w_k eval_k`, added up in this order.
+    pub(crate) fn part_bsdfs(&self) -> Option<impl Iterator<Item = (f64, &Bsdf)>> {
+        self.step
+            .is_none()
+            .then(|| self.entries[0].parts.iter().map(|(w, p)| (*w, &p.bsdf)))
+    }
+
     /// True for a θ_in-table shader.
     pub fn is_table(&self) -> bool {
         self.step.is_some()

@@ -1,10 +1,10 @@
 //! Pictures: determinism, the output formats, and a sphere light with a
 //! known answer.
 
-use crate::common::{mat, shader_of};
+use crate::common::{lobe_sums, mat, shader_of};
 use brtf_model::{EvalOptions, MaterialKind};
 use brtf_trace::hdr;
-use brtf_trace::{Camera, ImageOptions, Scene, Settings, Shape, Source, render};
+use brtf_trace::{Camera, ImageOptions, Scene, Settings, Shader, Shape, Source, render};
 use brtf_trace::{auto_exposure, write_png};
 use glam::DVec3;
 
@@ -172,20 +172,61 @@ fn batched_direct_rows_equal_the_per_ray_tracer_one_sample() {
     direct_rows_equal_the_per_ray_tracer(&options, false);
 }
 
+/// Lobe sums take the direct-light rows too (each lobe's batch, added up
+/// with its weight): a three-lobe plastic alone, then beside a two-lobe
+/// metal, every pixel and ray count equal to the per-ray tracer's.
+#[test]
+fn batched_direct_rows_equal_the_per_ray_tracer_for_lobe_sums() {
+    let options = ImageOptions {
+        width: 40,
+        height: 30,
+        samples: 2,
+        jitter: true,
+        seed: 5,
+        settings: Settings::direct_only(),
+    };
+    let sums = lobe_sums();
+    let (_, plastic) = sums.iter().find(|(n, _)| *n == "plastic ×3").unwrap();
+    let (_, metal) = sums.iter().find(|(n, _)| *n == "metal ×2").unwrap();
+    let shader = |m| Shader::new(m, &EvalOptions::default()).unwrap();
+    let alone = Scene {
+        shaders: vec![shader(plastic)],
+        ..scene()
+    };
+    direct_rows_equal_the_per_ray_tracer_in(alone, &options, None);
+    let beside = Scene {
+        shaders: vec![shader(plastic)],
+        ..scene()
+    };
+    direct_rows_equal_the_per_ray_tracer_in(beside, &options, Some(shader(metal)));
+}
+
 /// Renders the test scene with a third sphere (of a second, transmitting
 /// material if `glass`, else of the first) and a sphere light, and
 /// compares every pixel with [`Tracer::radiance`].
 fn direct_rows_equal_the_per_ray_tracer(options: &ImageOptions, glass: bool) {
+    // A second, transmitting material lit from behind.
+    let glass = glass.then(|| {
+        let glass = mat(MaterialKind::Trans, &[0.7, 0.8, 0.9, 0.04, 0.05, 0.6, 0.3]);
+        shader_of(&glass, &EvalOptions::default())
+    });
+    direct_rows_equal_the_per_ray_tracer_in(scene(), options, glass);
+}
+
+/// [`direct_rows_equal_the_per_ray_tracer`] in `scene`, the third sphere
+/// of `second` if given (else of the first material).
+fn direct_rows_equal_the_per_ray_tracer_in(
+    mut scene: Scene,
+    options: &ImageOptions,
+    second: Option<Shader>,
+) {
     use brtf_model::Rng;
     use brtf_trace::RayCounts;
     use brtf_trace::Tracer;
-    let mut scene = scene();
-    // A second, transmitting material lit from behind, and a sphere light.
-    let id = if glass {
-        let glass = mat(MaterialKind::Trans, &[0.7, 0.8, 0.9, 0.04, 0.05, 0.6, 0.3]);
-        scene.add_shader(shader_of(&glass, &EvalOptions::default()))
-    } else {
-        0
+    // A second material, and a sphere light.
+    let id = match second {
+        Some(shader) => scene.add_shader(shader),
+        None => 0,
     };
     scene.add(
         Shape::Sphere {
