@@ -2,17 +2,23 @@
 //!
 //! Reads and writes Radiance primitives (`modifier type identifier`, then
 //! the string, integer and real argument lists), and converts the six
-//! Ward-type material primitives to and from [`brtf_model::Material`].
+//! Ward-type material primitives to and from [`brtf_model::Material`], and
+//! constant `mixfunc` trees of them (lobe sums) to and from
+//! [`brtf_model::Composite`].
 //! Errors carry the file and line: `file:line: message`.
 //!
 //! [`export`] writes a fit's Radiance materials: the static primitive, the
 //! θ_in-dependent function material with its `.cal` file, and a preview
 //! scene (`docs/radiance.md`).
 
+mod composite;
 pub mod export;
 mod name;
 mod primitive;
 
+pub use composite::{
+    MAX_MIXTURE_PARTS, composite_from_primitives, composite_primitives, select_composite,
+};
 pub use name::default_fit_name;
 
 pub use primitive::{

@@ -433,7 +433,7 @@ pub fn primitive_from_material(material: &Material, name: &str) -> Primitive {
 }
 
 /// Shortest text that reads back as the same f64.
-fn fmt_real(x: f64) -> String {
+pub(crate) fn fmt_real(x: f64) -> String {
     let s = format!("{x}");
     if s == "-0" { "0".into() } else { s }
 }

@@ -1,5 +1,6 @@
 //! brtf-radiance integration tests: primitives here, exports in `export`.
 
+mod composite;
 mod export;
 mod klems;
 mod primitive;
