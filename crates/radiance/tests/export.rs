@@ -9,7 +9,7 @@ use brtf_fit::{
 };
 use brtf_model::{EvalOptions, MaterialKind, Variant};
 use brtf_radiance::export::{ExportError, ExportOptions, exports, write_exports};
-use brtf_radiance::{parse_primitives, select_material};
+use brtf_radiance::{parse_primitives, select_composite, select_material};
 
 fn report(kind: MaterialKind, theta_in: f64, args: &[f64]) -> FitReport {
     FitReport {
@@ -361,4 +361,242 @@ fn hostile_strings_stay_inside_comments() {
             assert!(!f.text[1..header_end].contains(['{', '}']), "{}", f.text);
         }
     }
+}
+
+// ---------------------------------------------------------------------------
+// Lobe sums
+// ---------------------------------------------------------------------------
+
+/// [`fit`] of a lobe sum: `shape`'s flat arguments in every row, the
+/// anisotropic types' orientation `orientation`.
+fn lobe_fit(
+    name: &str,
+    shape: brtf_model::Shape,
+    orientation: [f64; 3],
+    rows: &[(f64, &[f64])],
+) -> FitResult {
+    let mut result = fit(name, shape.kind, Variant::Radiance, rows, Some(rows[0].1));
+    let names = shape.param_names();
+    for report in result.incidences.iter_mut().chain(result.global.as_mut()) {
+        for (p, name) in report.params.iter_mut().zip(&names) {
+            p.name = name.clone();
+        }
+    }
+    result.config.lobes = shape.lobes;
+    result.config.oriented = shape.oriented;
+    result.config.orientation = orientation;
+    result.table = Some(
+        ParamTable::from_reports(shape, orientation, &result.incidences, Interpolation::Pchip)
+            .unwrap(),
+    );
+    result
+}
+
+/// Every function the `.cal` text calls is defined in it or by Radiance
+/// (rayinit.cal and the built-ins), and none is defined twice.
+#[track_caller]
+fn assert_cal_is_closed(cal: &str) {
+    const RADIANCE: &[&str] = &[
+        "if", "select", "exp", "sqrt", "acos", "abs", "min", "max", "cos", "sin", "atan2", "floor",
+        "and", "or", "sq",
+    ];
+    let mut code = String::new();
+    let mut depth = 0;
+    for c in cal.chars() {
+        match c {
+            '{' => depth += 1,
+            '}' => depth -= 1,
+            _ if depth == 0 => code.push(c),
+            _ => {}
+        }
+    }
+    let mut defined = Vec::new();
+    for statement in code.split(';') {
+        let s = statement.trim_start();
+        let head: String = s
+            .chars()
+            .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+            .collect();
+        let rest = &s[head.len()..];
+        let rest = match rest.find(')') {
+            Some(close) if rest.starts_with('(') => &rest[close + 1..],
+            _ => rest,
+        };
+        if !head.is_empty() && rest.trim_start().starts_with(['=', ':']) {
+            assert!(!defined.contains(&head), "`{head}` defined twice");
+            defined.push(head);
+        }
+    }
+    let mut word = String::new();
+    let mut number = false;
+    for c in code.chars() {
+        if c.is_ascii_alphanumeric() || c == '_' || (number && c == '.') {
+            if word.is_empty() {
+                number = c.is_ascii_digit();
+            }
+            word.push(c);
+            continue;
+        }
+        if c == '(' && !number && !word.is_empty() {
+            assert!(
+                defined.contains(&word) || RADIANCE.contains(&word.as_str()),
+                "`{word}` is called but not defined"
+            );
+        }
+        word.clear();
+        number = false;
+    }
+}
+
+#[test]
+fn lobe_sum_exports_hold_the_lobes() {
+    use brtf_model::Shape;
+    let shape = Shape::new(MaterialKind::Metal, 2, false).unwrap();
+    // red green blue spec split1 rough1 rough2
+    let result = lobe_fit(
+        "alu",
+        shape,
+        [1.0, 0.0, 0.0],
+        &[
+            (0.0, &[0.93, 0.93, 0.93, 0.86, 0.42, 0.085, 0.18]),
+            (30.0, &[0.95, 0.95, 0.95, 0.88, 0.45, 0.087, 0.2]),
+            (60.0, &[0.98, 0.98, 0.98, 0.92, 0.37, 0.085, 0.2]),
+        ],
+    );
+    let export = exports(&result, &ExportOptions::default()).unwrap();
+    let stat = file(&export, "alu.rad");
+    assert!(stat.contains("static Radiance lobe sum (2 metal primitives in a mixfunc)"));
+    assert!(stat.contains("Fitted arguments (red green blue spec split1 rough1 rough2)"));
+    assert!(
+        stat.ends_with("void mixfunc alu\n4 alu.1 alu.2 0.42 .\n0\n0\n"),
+        "{stat}"
+    );
+    let prims = parse_primitives(stat, "alu.rad").unwrap();
+    let (name, material) = select_composite(&prims, None, "alu.rad").unwrap();
+    assert_eq!(name, "alu");
+    let fitted = result.static_composite().unwrap();
+    assert_eq!(material.shape(), Some(shape));
+    for (a, b) in material.args().unwrap().iter().zip(fitted.args().unwrap()) {
+        assert!((a - b).abs() < 1e-15);
+    }
+    // One BRTDfunc whose functions add the lobes with their weights.
+    let theta = file(&export, "alu-theta.rad");
+    assert!(theta.contains("void BRTDfunc alu\n"), "{theta}");
+    assert!(theta.contains("A lobe sum: the functions add the 2 metal lobes"));
+    let cal = file(&export, "alu-theta.cal");
+    for needle in [
+        "w_lobe1(t) = p_split1(t);",
+        "w_lobe2(t) = (1 - p_split1(t));",
+        "lobe_2(c, hx, hy, hz, om, t) = lobe_h_2(",
+        "sq(p_rough2(t)) + om/(4*PI)",
+        "refl(k, c, hx, hy, hz, om, t) = w_lobe1(t)*refl_1(k, c, hx, hy, hz, om, t)\n\t+ w_lobe2(t)*refl_2(",
+        "  theta_in        red     green      blue      spec    split1    rough1    rough2",
+    ] {
+        assert!(cal.contains(needle), "`{needle}` not in\n{cal}");
+    }
+    assert_cal_is_closed(cal);
+    // The preview uses the material's name.
+    assert!(file(&export, "alu-preview.rad").contains("alu sphere alu-preview_ball"));
+    // --at: the interpolated lobe sum.
+    let options = ExportOptions {
+        at: Some(45.0),
+        name: Some("x".into()),
+        ..ExportOptions::default()
+    };
+    let export = exports(&result, &options).unwrap();
+    let prims = parse_primitives(file(&export, "x.rad"), "x.rad").unwrap();
+    let (_, at) = select_composite(&prims, None, "x.rad").unwrap();
+    let (want, _) = result.table.as_ref().unwrap().composite_at(45.0).unwrap();
+    for (a, b) in at.args().unwrap().iter().zip(want.args().unwrap()) {
+        assert!((a - b).abs() < 1e-15);
+    }
+}
+
+#[test]
+fn lobe_sums_whose_roughness_alone_changes_use_plasfunc() {
+    use brtf_model::Shape;
+    let shape = Shape::new(MaterialKind::Plastic, 3, false).unwrap();
+    let result = lobe_fit(
+        "p3",
+        shape,
+        [1.0, 0.0, 0.0],
+        &[
+            (0.0, &[0.5, 0.5, 0.5, 0.06, 0.3, 0.5, 0.02, 0.1, 0.3]),
+            (45.0, &[0.5, 0.5, 0.5, 0.06, 0.3, 0.5, 0.03, 0.12, 0.35]),
+        ],
+    );
+    let export = exports(&result, &ExportOptions::default()).unwrap();
+    assert!(file(&export, "p3-theta.rad").contains("void plasfunc p3\n2 f_lobe p3-theta.cal\n"));
+    let cal = file(&export, "p3-theta.cal");
+    assert!(cal.contains(
+        "lobe(c, hx, hy, hz, om, t) = w_lobe1(t)*lobe_1(c, hx, hy, hz, om, t)\n\
+         \t+ w_lobe2(t)*lobe_2(c, hx, hy, hz, om, t)\n\t+ w_lobe3(t)*lobe_3("
+    ));
+    assert!(cal.contains("w_lobe3(t) = (1 - p_split1(t))*(1 - p_split2(t));"));
+    assert_cal_is_closed(cal);
+    let stat = file(&export, "p3.rad");
+    assert!(stat.contains("void mixfunc p3.mix2\n4 p3.2 p3.3 0.5 .\n"));
+}
+
+#[test]
+fn a_fitted_orientation_turns_the_frame_with_theta_in() {
+    use brtf_model::Shape;
+    let shape = Shape::new(MaterialKind::Plastic2, 2, true).unwrap();
+    // ... split1 rough_u1 rough_v1 rough_u2 rough_v2 orient
+    let result = lobe_fit(
+        "brushed",
+        shape,
+        [1.0, 0.0, 0.0],
+        &[
+            (
+                20.0,
+                &[0.5, 0.45, 0.4, 0.06, 0.55, 0.05, 0.15, 0.2, 0.08, 28.0],
+            ),
+            (
+                50.0,
+                &[0.5, 0.45, 0.4, 0.06, 0.55, 0.05, 0.15, 0.2, 0.08, 33.0],
+            ),
+        ],
+    );
+    let export = exports(&result, &ExportOptions::default()).unwrap();
+    let cal = file(&export, "brushed-theta.cal");
+    for needle in [
+        "u0x(t) = cos(p_orient(t)*DEGREE); u0y(t) = sin(p_orient(t)*DEGREE); u0z(t) = 0;",
+        "hx*uhx(t) + hy*uhy(t) + hz*uhz(t)",
+        "w2u_1(t) = if(crl(t), sq(p_rough_u1(t)),",
+        "w2v_2(t) = if(crl(t), sq(p_rough_v2(t)),",
+    ] {
+        assert!(cal.contains(needle), "`{needle}` not in\n{cal}");
+    }
+    assert_cal_is_closed(cal);
+    // The static material: the orientation of the all-incidence angle.
+    let stat = file(&export, "brushed.rad");
+    assert!(stat.contains("the fitted angle orient = 28 deg"), "{stat}");
+    let prims = parse_primitives(stat, "b.rad").unwrap();
+    let (_, m) = select_composite(&prims, None, "b.rad").unwrap();
+    let o = m.components()[1].1.orientation();
+    assert!((o.y.atan2(o.x).to_degrees() - 28.0).abs() < 1e-12);
+
+    // A table that also follows φ_in, counted from a fitted orientation: no
+    // θ_in-dependent material, and a note says why.
+    let mut azimuth = result.clone();
+    let table = azimuth.table.as_mut().unwrap();
+    table.azimuth = Some(
+        table
+            .args
+            .iter()
+            .map(|a| brtf_fit::AzimuthRing {
+                phi_in: vec![0.0],
+                args: vec![a.clone()],
+            })
+            .collect(),
+    );
+    let export = exports(&azimuth, &ExportOptions::default()).unwrap();
+    assert_eq!(export.files.len(), 2);
+    assert!(
+        export
+            .notes
+            .iter()
+            .any(|n| n.contains("orientation is fitted too"))
+    );
 }

@@ -30,7 +30,8 @@
 use super::num::num;
 use super::pieces::{FALLBACK_STEP, Pieces};
 use brtf_fit::{Interpolation, ParamTable};
-use brtf_model::{MaterialKind, Variant};
+use brtf_model::{MaterialKind, Shape, Variant};
+use std::collections::HashMap;
 use std::fmt::Write;
 
 /// Channel function names of the `BRTDfunc` entry.
@@ -63,6 +64,8 @@ pub(crate) enum Entry {
 #[derive(Debug, Clone)]
 pub(crate) struct CalModel<'a> {
     pub kind: MaterialKind,
+    /// The shape: lobes and whether the orientation angle is a parameter.
+    pub shape: Shape,
     pub variant: Variant,
     /// `K` of the roughness-0 Fresnel estimate (radiance variant).
     pub fresnel_k: f64,
@@ -112,6 +115,9 @@ impl CalModel<'_> {
 
     /// Sections 4 to 7, after the parameters, constants and geometry.
     fn model(&self, o: &mut String) {
+        if self.shape.lobes > 1 {
+            return self.lobe_sum_model(o);
+        }
         match self.entry {
             Entry::Brtd { .. } => self.coefficients(o),
             Entry::Lobe => {}
@@ -151,7 +157,7 @@ impl CalModel<'_> {
         *o +=
             "endslope(h0, h1, d0, d1) : endslope_s((( 2*h0 + h1)*d0 - h0*d1)/(h0 + h1), d0, d1);\n";
         *o += "endslope_s(s, d0, d1) : if(s*d0, if(and(-(d0*d1) + 1e-300, abs(s) - 3*abs(d0)), 3*d0, s), 0);\n";
-        let names = self.kind.param_names();
+        let names = self.shape.param_names();
         for (p, name) in names.iter().enumerate() {
             *o += "\n";
             let same = |q: usize| rings.iter().all(|r| r.args.iter().all(|a| a[q] == a[p]));
@@ -288,7 +294,7 @@ impl CalModel<'_> {
         let _ = writeln!(o, "t_hi : {};", num(hi));
         *o += "t_clamp(t) : if(t - t_hi, t_hi, if(t_lo - t, t_lo, t));\n";
         *o += "cubic(s, a0, a1, a2, a3) : a0 + s*(a1 + s*(a2 + s*a3));\n";
-        let names = self.kind.param_names();
+        let names = self.shape.param_names();
         for (p, name) in names.iter().enumerate() {
             let segs = &self.pieces.segments[p];
             *o += "\n";
@@ -354,19 +360,59 @@ impl CalModel<'_> {
             *o += "e6 = exp(-6*cosv);                       { Ward 1992 Fresnel estimate }\n";
         }
         if !self.iso() {
-            let [x, y, z] = self.orientation;
             *o +=
                 "{ Tangent frame: v_hat = normalize(N x u0), u_hat = v_hat x N; the u roughness\n";
             *o += "  applies along u_hat. u0 parallel to N: mean roughness on both axes. }\n";
-            let _ = writeln!(o, "u0x : {}; u0y : {}; u0z : {};", num(x), num(y), num(z));
-            *o += "crx = NyP*u0z - NzP*u0y; cry = NzP*u0x - NxP*u0z; crz = NxP*u0y - NyP*u0x;\n";
-            *o += "crl = sqrt(crx*crx + cry*cry + crz*crz);\n";
-            *o += "vhx = if(crl, crx/crl, 0); vhy = if(crl, cry/crl, 0); vhz = if(crl, crz/crl, 0);\n";
-            *o += "uhx = vhy*NzP - vhz*NyP; uhy = vhz*NxP - vhx*NzP; uhz = vhx*NyP - vhy*NxP;\n";
-            *o += "w2u(t) = if(crl, sq(p_rough_u(t)), (sq(p_rough_u(t)) + sq(p_rough_v(t)))/2);\n";
-            *o += "w2v(t) = if(crl, sq(p_rough_v(t)), (sq(p_rough_u(t)) + sq(p_rough_v(t)))/2);\n";
+            if self.shape.oriented {
+                *o +=
+                    "{ u0 turns in the surface plane by the fitted angle orient, degrees from +x\n";
+                *o += "  towards +y, which follows theta_in = t like every parameter. }\n";
+                *o += "u0x(t) = cos(p_orient(t)*DEGREE); u0y(t) = sin(p_orient(t)*DEGREE); u0z(t) = 0;\n";
+                *o += "crx(t) = NyP*u0z(t) - NzP*u0y(t); cry(t) = NzP*u0x(t) - NxP*u0z(t);\n";
+                *o += "crz(t) = NxP*u0y(t) - NyP*u0x(t);\n";
+                *o += "crl(t) = sqrt(crx(t)*crx(t) + cry(t)*cry(t) + crz(t)*crz(t));\n";
+                *o += "vhx(t) = if(crl(t), crx(t)/crl(t), 0); vhy(t) = if(crl(t), cry(t)/crl(t), 0);\n";
+                *o += "vhz(t) = if(crl(t), crz(t)/crl(t), 0);\n";
+                *o += "uhx(t) = vhy(t)*NzP - vhz(t)*NyP; uhy(t) = vhz(t)*NxP - vhx(t)*NzP;\n";
+                *o += "uhz(t) = vhx(t)*NyP - vhy(t)*NxP;\n";
+            } else {
+                let [x, y, z] = self.orientation;
+                let _ = writeln!(o, "u0x : {}; u0y : {}; u0z : {};", num(x), num(y), num(z));
+                *o +=
+                    "crx = NyP*u0z - NzP*u0y; cry = NzP*u0x - NxP*u0z; crz = NxP*u0y - NyP*u0x;\n";
+                *o += "crl = sqrt(crx*crx + cry*cry + crz*crz);\n";
+                *o += "vhx = if(crl, crx/crl, 0); vhy = if(crl, cry/crl, 0); vhz = if(crl, crz/crl, 0);\n";
+                *o +=
+                    "uhx = vhy*NzP - vhz*NyP; uhy = vhz*NxP - vhx*NzP; uhz = vhx*NyP - vhy*NxP;\n";
+            }
+            if self.shape.lobes == 1 {
+                self.roughness_squares(o);
+            }
         }
         *o += "\n";
+    }
+
+    /// A frame quantity of section 3: a variable, or a function of `t`
+    /// when the orientation follows θ_in.
+    fn frame(&self, name: &str) -> String {
+        if self.shape.oriented {
+            format!("{name}(t)")
+        } else {
+            name.to_string()
+        }
+    }
+
+    /// `w2u(t)`, `w2v(t)`: the squared roughnesses along u_hat and v_hat.
+    fn roughness_squares(&self, o: &mut String) {
+        let crl = self.frame("crl");
+        let _ = writeln!(
+            o,
+            "w2u(t) = if({crl}, sq(p_rough_u(t)), (sq(p_rough_u(t)) + sq(p_rough_v(t)))/2);"
+        );
+        let _ = writeln!(
+            o,
+            "w2v(t) = if({crl}, sq(p_rough_v(t)), (sq(p_rough_u(t)) + sq(p_rough_v(t)))/2);"
+        );
     }
 
     /// Section 4: the split into specular, diffuse and transmitted parts
@@ -375,8 +421,11 @@ impl CalModel<'_> {
         let radiance = self.variant == Variant::Radiance;
         let ward = self.variant == Variant::Ward1992;
         let metal = self.kind.is_metal();
-        *o += "{ ===== 4. Specular, diffuse and transmitted fractions at theta_in = t =====\n";
-        *o += "  The colour is modified by a pattern on the material, if any (CrP CgP CbP). }\n";
+        if self.shape.lobes == 1 {
+            *o += "{ ===== 4. Specular, diffuse and transmitted fractions at theta_in = t =====\n";
+            *o +=
+                "  The colour is modified by a pattern on the material, if any (CrP CgP CbP). }\n";
+        }
         *o += "col(k, t) = select(k, p_red(t)*CrP, p_green(t)*CgP, p_blue(t)*CbP);\n";
         if self.iso() {
             *o += "pure(t) : if(sq(p_rough(t)) - ftiny, -1, 1);   { roughness <= 0.001: mirror-like }\n";
@@ -418,9 +467,13 @@ impl CalModel<'_> {
     /// Section 5: the reflected (and transmitted) specular lobes.
     fn lobes(&self, o: &mut String) {
         let widen = "om/(4*PI)";
-        *o += "{ ===== 5. Specular lobes (no specularity or colour); c = |light cosine|,\n";
-        *o += "  h = l + v (not normalised), om = source solid angle. The reflected lobe is\n";
-        *o += "  widened by om/(4 pi) as rtrace does on flat surfaces. }\n";
+        if self.shape.lobes == 1 {
+            *o += "{ ===== 5. Specular lobes (no specularity or colour); c = |light cosine|,\n";
+            *o += "  h = l + v (not normalised), om = source solid angle. The reflected lobe is\n";
+            *o += "  widened by om/(4 pi) as rtrace does on flat surfaces. }\n";
+        }
+        let [ux, uy, uz, vx, vy, vz] =
+            ["uhx", "uhy", "uhz", "vhx", "vhy", "vhz"].map(|n| self.frame(n));
         if self.iso() {
             let _ = writeln!(
                 o,
@@ -441,7 +494,7 @@ impl CalModel<'_> {
             let _ = writeln!(
                 o,
                 "lobe(c, hx, hy, hz, om, t) = lobe_h(c, hx*hx + hy*hy + hz*hz, hx*NxP + hy*NyP + hz*NzP,\n\
-                 \thx*uhx + hy*uhy + hz*uhz, hx*vhx + hy*vhy + hz*vhz, w2u(t) + {widen}, w2v(t) + {widen});"
+                 \thx*{ux} + hy*{uy} + hz*{uz}, hx*{vx} + hy*{vy} + hz*{vz}, w2u(t) + {widen}, w2v(t) + {widen});"
             );
             *o += match self.variant {
                 Variant::Radiance => {
@@ -470,8 +523,11 @@ impl CalModel<'_> {
                 };
                 let _ = writeln!(o, "tlobe_h(c, x, b) = {g}/{geometry};");
             } else {
-                *o += "tlobe(c, hx, hy, hz, om, t) = tlobe_h(c, hx*hx + hy*hy + hz*hz, hx*NxP + hy*NyP + hz*NzP,\n\
-                       \thx*uhx + hy*uhy + hz*uhz, hx*vhx + hy*vhy + hz*vhz, w2u(t) + om/PI, w2v(t) + om/PI);\n";
+                let _ = writeln!(
+                    o,
+                    "tlobe(c, hx, hy, hz, om, t) = tlobe_h(c, hx*hx + hy*hy + hz*hz, hx*NxP + hy*NyP + hz*NzP,\n\
+                     \thx*{ux} + hy*{uy} + hz*{uz}, hx*{vx} + hy*{vy} + hz*{vz}, w2u(t) + om/PI, w2v(t) + om/PI);"
+                );
                 *o += "tlobe_h(c, hh, hn, hu, hv, bu, bv) = tlobe_e(c, ex(tl_x(tl_s2(hh, hn), hu, hv, bu, bv)), bu, bv);\n";
                 *o += "tl_s2(hh, hn) = if(hh - 1e-12, 1 - hn*hn/hh, hh);\n";
                 *o += "tl_x(s2, hu, hv, bu, bv) = if(s2 - 1e-12, (hu*hu/bu + hv*hv/bv)/s2, 0);\n";
@@ -490,6 +546,31 @@ impl CalModel<'_> {
 
     /// Section 6 for `BRTDfunc`: the whole BSDF per channel.
     fn brtd_entry(&self, o: &mut String, rd0: [f64; 3], td0: [f64; 3], deltas: bool) {
+        *o +=
+            "{ ===== 6. The BSDF f(l, v) in 1/sr for channel k (1 red, 2 green, 3 blue) ===== }\n";
+        self.brtd_head(o);
+        self.brtd_lobe(o);
+        self.brtd_channels(o, rd0, td0);
+        if deltas {
+            self.delta_head(o);
+            self.mirror_function(o);
+            self.delta_variables(o);
+        }
+    }
+
+    /// `bsdf` and `bsdf_c`: the light's cosine, half vector and θ_in.
+    fn brtd_head(&self, o: &mut String) {
+        *o += "bsdf(k, lx, ly, lz, om) = bsdf_c(k, cosl(lx, ly, lz), lx + vx, ly + vy, lz + vz, om);\n";
+        if self.transmitting() {
+            *o += "bsdf_c(k, c, hx, hy, hz, om) = if(c, refl(k, c, hx, hy, hz, om, thin(c)),\n\
+                   \tif(-c, trans(k, -c, hx, hy, hz, om, thin(c)), 0));\n";
+        } else {
+            *o += "bsdf_c(k, c, hx, hy, hz, om) = if(c, refl(k, c, hx, hy, hz, om, thin(c)), 0);\n";
+        }
+    }
+
+    /// `refl` (and `trans`) of one primitive at θ_in = t.
+    fn brtd_lobe(&self, o: &mut String) {
         let ward_metal = self.variant == Variant::Ward1992 && self.kind.is_metal();
         let lfres = if self.variant == Variant::Radiance && self.iso() {
             "*lfres(c, t)"
@@ -503,16 +584,10 @@ impl CalModel<'_> {
                 cond.to_string()
             }
         };
-        *o +=
-            "{ ===== 6. The BSDF f(l, v) in 1/sr for channel k (1 red, 2 green, 3 blue) ===== }\n";
-        *o += "bsdf(k, lx, ly, lz, om) = bsdf_c(k, cosl(lx, ly, lz), lx + vx, ly + vy, lz + vz, om);\n";
         if self.transmitting() {
-            *o += "bsdf_c(k, c, hx, hy, hz, om) = if(c, refl(k, c, hx, hy, hz, om, thin(c)),\n\
-                   \tif(-c, trans(k, -c, hx, hy, hz, om, thin(c)), 0));\n";
             *o += "refl(k, c, hx, hy, hz, om, t) = if(trn(t) - (1 - ftiny), 0,\n\
                    \trdiff(k, c, t) + rspec(k, c, hx, hy, hz, om, t));\n";
         } else {
-            *o += "bsdf_c(k, c, hx, hy, hz, om) = if(c, refl(k, c, hx, hy, hz, om, thin(c)), 0);\n";
             *o += "refl(k, c, hx, hy, hz, om, t) = rdiff(k, c, t) + rspec(k, c, hx, hy, hz, om, t);\n";
         }
         if ward_metal {
@@ -548,6 +623,10 @@ impl CalModel<'_> {
                 not_pure("tsp(t) - ftiny")
             );
         }
+    }
+
+    /// Section 7: the constant diffuse parts and the channel functions.
+    fn brtd_channels(&self, o: &mut String, rd0: [f64; 3], td0: [f64; 3]) {
         *o += "\n{ ===== 7. What BRTDfunc calls =====\n";
         *o += "  The material's real arguments hold constant diffuse parts (the smallest over\n";
         *o += "  theta_in, so they also serve indirect light; Radiance applies a pattern to\n";
@@ -570,27 +649,124 @@ impl CalModel<'_> {
                 ["CrP", "CgP", "CbP"][k]
             );
         }
-        if deltas {
-            *o += "\n{ Roughness 0: mirror and straight-through coefficients, at the view's theta. }\n";
-            *o += "tview = acos(min(1, RdotP))/DEGREE;\n";
-            let mirror = if self.kind.is_metal() {
-                if self.variant == Variant::Radiance {
-                    "if(and(fresnel(t), fres(cosv) - ftiny), fres(cosv) + col(k, t)*p_spec(t)*(1 - fres(cosv)), col(k, t)*p_spec(t))"
-                } else {
-                    "col(k, t)*p_spec(t)"
-                }
+    }
+
+    /// The roughness-0 comment and the view's θ.
+    fn delta_head(&self, o: &mut String) {
+        *o += "\n{ Roughness 0: mirror and straight-through coefficients, at the view's theta. }\n";
+        *o += "tview = acos(min(1, RdotP))/DEGREE;\n";
+    }
+
+    /// `mirror(k, t)` of one primitive.
+    fn mirror_function(&self, o: &mut String) {
+        let mirror = if self.kind.is_metal() {
+            if self.variant == Variant::Radiance {
+                "if(and(fresnel(t), fres(cosv) - ftiny), fres(cosv) + col(k, t)*p_spec(t)*(1 - fres(cosv)), col(k, t)*p_spec(t))"
             } else {
-                "spec(t)"
-            };
-            let _ = writeln!(o, "mirror(k, t) = if(pure(t), {mirror}, 0);");
-            for (k, var) in MIRROR_VARIABLES.iter().enumerate() {
-                let _ = writeln!(o, "{var} = mirror({}, tview);", k + 1);
+                "col(k, t)*p_spec(t)"
             }
-            if self.transmitting() {
-                *o += "through(k, t) = if(pure(t), col(k, t)*tsp(t), 0);\n";
-                for (k, var) in THROUGH_VARIABLES.iter().enumerate() {
-                    let _ = writeln!(o, "{var} = through({}, tview);", k + 1);
+        } else {
+            "spec(t)"
+        };
+        let _ = writeln!(o, "mirror(k, t) = if(pure(t), {mirror}, 0);");
+    }
+
+    /// The variables BRTDfunc reads for the mirror and straight-through rays.
+    fn delta_variables(&self, o: &mut String) {
+        for (k, var) in MIRROR_VARIABLES.iter().enumerate() {
+            let _ = writeln!(o, "{var} = mirror({}, tview);", k + 1);
+        }
+        if self.transmitting() {
+            *o += "through(k, t) = if(pure(t), col(k, t)*tsp(t), 0);\n";
+            for (k, var) in THROUGH_VARIABLES.iter().enumerate() {
+                let _ = writeln!(o, "{var} = through({}, tview);", k + 1);
+            }
+        }
+    }
+
+    /// Sections 4 to 7 of a lobe sum: the weights, each lobe's functions
+    /// (those of one primitive with its roughness, named `…_j`), and the
+    /// entry functions summing the lobes with their weights at θ_in = t.
+    fn lobe_sum_model(&self, o: &mut String) {
+        let n = self.shape.lobes;
+        let aniso = !self.iso();
+        *o += "{ ===== 4. The lobes' weights at theta_in = t: stick-breaking splits, as the\n";
+        *o += "  static material's mixfunc tree mix(lobe 1, mix(lobe 2, ...), split1). }\n";
+        for j in 0..n {
+            let _ = writeln!(o, "w_lobe{}(t) = {};", j + 1, weight_expression(j, n));
+        }
+        *o += "\n";
+        let brtd = matches!(self.entry, Entry::Brtd { .. });
+        let deltas = matches!(self.entry, Entry::Brtd { deltas: true, .. });
+        for j in 1..=n {
+            let roughness = if aniso {
+                format!("rough_u{j} and rough_v{j}")
+            } else {
+                format!("rough{j}")
+            };
+            let _ = writeln!(
+                o,
+                "{{ ===== 5.{j} Lobe {j} of {n}: one {} with roughness {roughness}, its\n  \
+                 functions named ..._{j}. The colour is modified by a pattern, if any (CrP CgP\n  \
+                 CbP). Lobes are not normalised: c = |light cosine|, h = l + v, om = source\n  \
+                 solid angle, the lobe widened by om/(4 pi) as on flat surfaces. }}",
+                self.kind
+            );
+            let mut lobe = String::new();
+            if aniso {
+                self.roughness_squares(&mut lobe);
+            }
+            if brtd {
+                self.coefficients(&mut lobe);
+            }
+            self.lobes(&mut lobe);
+            if brtd {
+                self.brtd_lobe(&mut lobe);
+            }
+            if deltas {
+                self.mirror_function(&mut lobe);
+            }
+            *o += &rename_for_lobe(&lobe, j);
+            *o += "\n";
+        }
+        let sum = |call: &str| {
+            (1..=n)
+                .map(|j| format!("w_lobe{j}(t)*{}", call.replacen('(', &format!("_{j}("), 1)))
+                .collect::<Vec<_>>()
+                .join("\n\t+ ")
+        };
+        match self.entry {
+            Entry::Brtd { rd0, td0, deltas } => {
+                *o +=
+                    "{ ===== 6. The BSDF f(l, v) in 1/sr for channel k (1 red, 2 green, 3 blue):\n";
+                *o += "  the lobes' BSDFs weighted. }\n";
+                self.brtd_head(o);
+                let _ = writeln!(
+                    o,
+                    "refl(k, c, hx, hy, hz, om, t) = {};",
+                    sum("refl(k, c, hx, hy, hz, om, t)")
+                );
+                self.brtd_channels(o, rd0, td0);
+                if deltas {
+                    self.delta_head(o);
+                    let _ = writeln!(o, "mirror(k, t) = {};", sum("mirror(k, t)"));
+                    self.delta_variables(o);
                 }
+            }
+            Entry::Lobe => {
+                *o += "{ ===== 6. What the material calls: the lobes at the light's theta_in,\n";
+                *o += "  weighted. Radiance scales them by the constant specularity (and colour, for\n";
+                *o += "  metals) and adds the constant diffuse part itself. }\n";
+                let _ = writeln!(
+                    o,
+                    "{LOBE_FUNCTION}(lx, ly, lz, om) = lobe_c(cosl(lx, ly, lz), lx + vx, ly + vy, lz + vz, om);"
+                );
+                *o += "lobe_c(c, hx, hy, hz, om) = if(c, lobe(c, hx, hy, hz, om, thin(c)), 0);\n";
+                let _ = writeln!(
+                    o,
+                    "lobe(c, hx, hy, hz, om, t) = {};",
+                    sum("lobe(c, hx, hy, hz, om, t)")
+                );
             }
         }
     }
@@ -615,6 +791,144 @@ impl CalModel<'_> {
     }
 }
 
+/// The weight of lobe `j` (0-based) of `n` at θ_in = t, from the splits
+/// by stick-breaking: `s1`, `(1 - s1) s2`, …, `Π (1 - s_k)`.
+fn weight_expression(j: usize, n: usize) -> String {
+    let mut factors: Vec<String> = (1..=j.min(n - 1))
+        .map(|k| format!("(1 - p_split{k}(t))"))
+        .collect();
+    if j < n - 1 {
+        factors.push(format!("p_split{}(t)", j + 1));
+    }
+    factors.join("*")
+}
+
+/// One primitive's functions made lobe `j`'s: every name the text
+/// defines gets the suffix `_j`, and the roughness parameters become lobe
+/// `j`'s (`p_rough` → `p_rough{j}`, `p_rough_u` → `p_rough_u{j}`, …).
+/// Comments are left as they are.
+fn rename_for_lobe(text: &str, j: usize) -> String {
+    let mut map: HashMap<String, String> = defined_names(text)
+        .into_iter()
+        .map(|name| {
+            let renamed = format!("{name}_{j}");
+            (name, renamed)
+        })
+        .collect();
+    for base in ["p_rough", "p_rough_u", "p_rough_v"] {
+        map.insert(base.to_string(), format!("{base}{j}"));
+    }
+    rename_identifiers(text, &map)
+}
+
+/// The text without its `{ … }` comments.
+fn without_comments(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut depth = 0usize;
+    for ch in text.chars() {
+        match ch {
+            '{' => depth += 1,
+            '}' => depth = depth.saturating_sub(1),
+            _ if depth == 0 => out.push(ch),
+            _ => {}
+        }
+    }
+    out
+}
+
+/// The names a function-file text defines: each statement's leading
+/// identifier when an argument list (or nothing) and then `=` or `:`
+/// follow it.
+fn defined_names(text: &str) -> Vec<String> {
+    let mut names = Vec::new();
+    for statement in without_comments(text).split(';') {
+        let s = statement.trim_start();
+        let end = s
+            .find(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+            .unwrap_or(s.len());
+        if end == 0 || !s.starts_with(|c: char| c.is_ascii_alphabetic() || c == '_') {
+            continue;
+        }
+        let mut rest = s[end..].trim_start();
+        if rest.starts_with('(') {
+            let mut depth = 0usize;
+            let mut close = None;
+            for (i, c) in rest.char_indices() {
+                match c {
+                    '(' => depth += 1,
+                    ')' => {
+                        depth -= 1;
+                        if depth == 0 {
+                            close = Some(i);
+                            break;
+                        }
+                    }
+                    _ => {}
+                }
+            }
+            let Some(close) = close else { continue };
+            rest = rest[close + 1..].trim_start();
+        }
+        if rest.starts_with(['=', ':']) {
+            let name = s[..end].to_string();
+            if !names.contains(&name) {
+                names.push(name);
+            }
+        }
+    }
+    names
+}
+
+/// `text` with every identifier in `map` replaced, outside comments;
+/// numbers (`1e-6`, `.5`) are kept whole.
+fn rename_identifiers(text: &str, map: &HashMap<String, String>) -> String {
+    let mut out = String::with_capacity(text.len() + text.len() / 8);
+    let chars: Vec<char> = text.chars().collect();
+    let mut i = 0;
+    let mut depth = 0usize;
+    while i < chars.len() {
+        let c = chars[i];
+        if c == '{' || (depth > 0 && c != '}') {
+            depth += usize::from(c == '{');
+            out.push(c);
+            i += 1;
+        } else if c == '}' {
+            depth = depth.saturating_sub(1);
+            out.push(c);
+            i += 1;
+        } else if c.is_ascii_digit() || c == '.' {
+            // A number: digits, a point, an exponent with its sign.
+            let start = i;
+            i += 1;
+            while i < chars.len() {
+                let d = chars[i];
+                if d.is_ascii_digit() || d == '.' {
+                    i += 1;
+                } else if matches!(d, 'e' | 'E') {
+                    i += 1;
+                    if i < chars.len() && matches!(chars[i], '+' | '-') {
+                        i += 1;
+                    }
+                } else {
+                    break;
+                }
+            }
+            out.extend(&chars[start..i]);
+        } else if c.is_ascii_alphabetic() || c == '_' {
+            let start = i;
+            while i < chars.len() && (chars[i].is_ascii_alphanumeric() || chars[i] == '_') {
+                i += 1;
+            }
+            let word: String = chars[start..i].iter().collect();
+            out += map.get(&word).unwrap_or(&word);
+        } else {
+            out.push(c);
+            i += 1;
+        }
+    }
+    out
+}
+
 /// Sections 3 to 7 of a (θ_in, φ_in) table: every function of θ_in `t`
 /// also takes φ_in `f`, and the entry points work φ_in out from the light
 /// as they work out θ_in. The generated text passes `t` always as the
@@ -637,5 +951,40 @@ fn with_azimuth_argument(text: &str) -> String {
     match text.find("{ ===== 4.").or_else(|| text.find("{ ===== 5.")) {
         Some(at) => format!("{}{azimuth}{}", &text[..at], &text[at..]),
         None => format!("{azimuth}{text}"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_lobe_s_names_get_its_suffix_and_nothing_else_does() {
+        let text = "{ lobe(c) and p_rough stay in comments }\n\
+                    pure(t) : if(sq(p_rough(t)) - 1e-6, -1, 1);\n\
+                    lobe(c, t) = lobe_h(c, sq(p_rough_u(t)) + om/(4*PI))\n\
+                    \t+ if(pure(t), 2.5e-3, .5);\n\
+                    lobe_h(c, w) = exp(-c/w); e6 = exp(-6*cosv);\n";
+        assert_eq!(defined_names(text), ["pure", "lobe", "lobe_h", "e6"]);
+        let renamed = rename_for_lobe(text, 2);
+        assert_eq!(
+            renamed,
+            "{ lobe(c) and p_rough stay in comments }\n\
+             pure_2(t) : if(sq(p_rough2(t)) - 1e-6, -1, 1);\n\
+             lobe_2(c, t) = lobe_h_2(c, sq(p_rough_u2(t)) + om/(4*PI))\n\
+             \t+ if(pure_2(t), 2.5e-3, .5);\n\
+             lobe_h_2(c, w) = exp(-c/w); e6_2 = exp(-6*cosv);\n"
+        );
+    }
+
+    #[test]
+    fn weights_break_the_stick() {
+        assert_eq!(weight_expression(0, 2), "p_split1(t)");
+        assert_eq!(weight_expression(1, 2), "(1 - p_split1(t))");
+        assert_eq!(weight_expression(1, 3), "(1 - p_split1(t))*p_split2(t)");
+        assert_eq!(
+            weight_expression(2, 3),
+            "(1 - p_split1(t))*(1 - p_split2(t))"
+        );
     }
 }

@@ -3,9 +3,9 @@
 //!
 //! | file | what |
 //! |---|---|
-//! | `<name>.rad` | the **static** material: one `plastic`/`metal`/`trans` (or `*2`) primitive from the all-incidence fit, or from the table at a chosen θ_in, with a comment header (provenance, fit quality, variant, caveats) |
+//! | `<name>.rad` | the **static** material: one `plastic`/`metal`/`trans` (or `*2`) primitive from the all-incidence fit, or from the table at a chosen θ_in, with a comment header (provenance, fit quality, variant, caveats); a lobe sum is its primitives `<name>.1` … and the constant `mixfunc` tree `<name>` that mixes them, last |
 //! | `<name>-theta.rad` | the **θ_in-dependent** material: a `BRTDfunc` (or `plasfunc`/`metfunc`/`transfunc` when they suffice) with the same identifier |
-//! | `<name>-theta.cal` | its function file: the parameter table as exact cubic segments and brtf-model's BSDF in Radiance's function language |
+//! | `<name>-theta.cal` | its function file: the parameter table as exact cubic segments and brtf-model's BSDF in Radiance's function language (a lobe sum's lobes summed with their θ_in-dependent weights) |
 //! | `<name>-preview.rad` | a small scene (sphere and floor under a sun and a sky) that either material file can be rendered with |
 //!
 //! Everything is built in memory first ([`exports`]); [`write_exports`]
@@ -23,7 +23,7 @@ mod static_material;
 mod theta;
 
 use brtf_fit::{FitReport, FitResult};
-use brtf_model::{Material, MaterialKind, ModelError};
+use brtf_model::{Composite, MaterialKind, ModelError};
 use std::path::{Path, PathBuf};
 
 /// What to export.
@@ -84,6 +84,9 @@ pub enum ExportError {
         /// What is wrong.
         source: ModelError,
     },
+    /// The θ_in table's shape is not one brtf fits.
+    #[error("the θ_in table: {0}")]
+    Table(String),
     /// `--at` cannot be served.
     #[error("--at {theta}: {reason}")]
     At {
@@ -163,6 +166,14 @@ pub fn exports(result: &FitResult, options: &ExportOptions) -> Result<Export, Ex
     let mut files = Vec::new();
     let mut notes = Vec::new();
     let theta = match (&result.table, options.theta_dependent) {
+        (Some(table), true) if table.oriented && table.depends_on_azimuth() => {
+            notes.push(
+                "no θ_in-dependent material: the table follows φ_in, which is counted from the \
+                 orientation, and the orientation is fitted too"
+                    .into(),
+            );
+            None
+        }
         (Some(table), true) => Some(theta::build(result, table, &name)?),
         (None, true) => {
             notes.push(format!(
@@ -255,14 +266,14 @@ fn material_name(result: &FitResult, options: &ExportOptions) -> Result<String, 
     Ok(name)
 }
 
-/// The material of a fitted report, or a located error.
-fn material_of(
+/// The material (any shape) of a fitted report, or a located error.
+fn composite_of(
     result: &FitResult,
     report: &FitReport,
     what: &str,
-) -> Result<Material, ExportError> {
-    Material::new(
-        result.config.kind,
+) -> Result<Composite, ExportError> {
+    Composite::new(
+        result.config.shape(),
         &report.material_args,
         Some(glam::DVec3::from_array(result.config.orientation)),
     )

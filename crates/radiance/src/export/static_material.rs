@@ -1,12 +1,15 @@
-//! The static material `<name>.rad`: one Ward-type primitive with a comment
-//! header that says where its parameters come from, how well they fit,
-//! which formula set was fitted, and what to watch out for.
+//! The static material `<name>.rad`: one Ward-type primitive (or a lobe
+//! sum: its primitives and the constant `mixfunc` tree named `<name>`)
+//! with a comment header that says where its parameters come from, how
+//! well they fit, which formula set was fitted, and what to watch out for.
 
+use super::num::sig;
 use super::report::{self, ascii};
-use super::{ExportError, material_of};
-use crate::primitive::{format_primitive, primitive_from_material};
+use super::{ExportError, composite_of};
+use crate::composite::composite_primitives;
+use crate::primitive::format_primitive;
 use brtf_fit::{FitReport, FitResult};
-use brtf_model::{Material, Variant};
+use brtf_model::{Composite, Variant};
 
 /// Where the static parameters come from.
 #[derive(Debug, Clone, Copy)]
@@ -20,9 +23,9 @@ pub(crate) enum Origin<'a> {
 }
 
 /// The static material and its origin.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub(crate) struct Chosen<'a> {
-    pub material: Material,
+    pub material: Composite,
     pub origin: Origin<'a>,
 }
 
@@ -38,13 +41,13 @@ pub(crate) fn choose(result: &FitResult, at: Option<f64>) -> Result<Chosen<'_>, 
     let Some(theta) = at else {
         if let Some(global) = &result.global {
             return Ok(Chosen {
-                material: material_of(result, global, "the all-incidence fit")?,
+                material: composite_of(result, global, "the all-incidence fit")?,
                 origin: Origin::Global(global),
             });
         }
         let first = result.incidences.first().ok_or(ExportError::NoParameters)?;
         return Ok(Chosen {
-            material: material_of(result, first, "the first incidence")?,
+            material: composite_of(result, first, "the first incidence")?,
             origin: Origin::Incidence(first),
         });
     };
@@ -60,7 +63,7 @@ pub(crate) fn choose(result: &FitResult, at: Option<f64>) -> Result<Chosen<'_>, 
         .find(|r| (r.theta_in - theta).abs() < 1e-9)
     {
         return Ok(Chosen {
-            material: material_of(result, report, &format!("θ_in = {theta}"))?,
+            material: composite_of(result, report, &format!("θ_in = {theta}"))?,
             origin: Origin::Incidence(report),
         });
     }
@@ -82,16 +85,13 @@ pub(crate) fn choose(result: &FitResult, at: Option<f64>) -> Result<Chosen<'_>, 
             ),
         });
     };
-    let lookup = table.at(theta).map_err(|e| ExportError::At {
+    let (material, clamped) = table.composite_at(theta).map_err(|e| ExportError::At {
         theta,
         reason: e.to_string(),
     })?;
     Ok(Chosen {
-        material: lookup.material,
-        origin: Origin::Interpolated {
-            theta,
-            clamped: lookup.clamped,
-        },
+        material,
+        origin: Origin::Interpolated { theta, clamped },
     })
 }
 
@@ -99,11 +99,18 @@ pub(crate) fn choose(result: &FitResult, at: Option<f64>) -> Result<Chosen<'_>, 
 pub(crate) fn text(result: &FitResult, chosen: &Chosen, name: &str, with_theta: bool) -> Text {
     let material = &chosen.material;
     let kind = material.kind();
+    let shape = result.config.shape();
+    let lobes = material.components().len();
     let options = result.options();
     let mut notes = Vec::new();
+    let what = if lobes > 1 {
+        format!("lobe sum ({} {kind} primitives in a mixfunc)", lobes)
+    } else {
+        kind.to_string()
+    };
     let mut h: Vec<String> = vec![
         format!(
-            "{}: static Radiance {kind} \"{name}\", written by brtf {} (brtf export).",
+            "{}: static Radiance {what} \"{name}\", written by brtf {} (brtf export).",
             super::static_file_name(name),
             env!("CARGO_PKG_VERSION")
         ),
@@ -199,9 +206,18 @@ pub(crate) fn text(result: &FitResult, chosen: &Chosen, name: &str, with_theta: 
     caveats.extend(report::energy_caveats(material, &options));
     if kind.is_anisotropic() {
         let o = material.orientation();
+        let fitted = if shape.oriented {
+            let angle = o.y.atan2(o.x).to_degrees();
+            format!(
+                " (the fitted angle orient = {} deg from +x towards +y)",
+                sig(angle, 6)
+            )
+        } else {
+            String::new()
+        };
         caveats.push(format!(
-            "the orientation vector ({} {} {}) is in the coordinates of the surface: the u \
-             roughness applies along its projection onto the surface.",
+            "the orientation vector ({} {} {}){fitted} is in the coordinates of the surface: \
+             the u roughness applies along its projection onto the surface.",
             o.x, o.y, o.z
         ));
     }
@@ -228,10 +244,62 @@ pub(crate) fn text(result: &FitResult, chosen: &Chosen, name: &str, with_theta: 
         "Preview: {} (docs/radiance.md explains both materials).",
         super::preview_file_name(name)
     ));
-    h.push(format!("Real arguments: {}.", report::argument_names(kind)));
+    if lobes > 1 {
+        h.extend(lobe_sum_lines(material, name));
+    } else {
+        h.push(format!(
+            "Real arguments: {}.",
+            report::argument_names(brtf_model::Shape::single(kind))
+        ));
+    }
     let mut text = comment_block(&h);
-    text += &format_primitive(&primitive_from_material(material, name));
+    let primitives: Vec<String> = composite_primitives(material, name)
+        .iter()
+        .map(format_primitive)
+        .collect();
+    text += &primitives.join("\n");
     Text { text, notes }
+}
+
+/// How a lobe sum is written: its primitives, their weights, the tree.
+fn lobe_sum_lines(material: &Composite, name: &str) -> Vec<String> {
+    let parts = material.components();
+    let kind = material.kind();
+    let n = parts.len();
+    let mut h = vec![
+        format!(
+            "Lobe sum: {name}.1 to {name}.{n} are {kind} primitives, one per specular lobe; the \
+             mixfunc \"{name}\""
+        ),
+        "(last) mixes them with constant weights, which rtrace adds linearly:".into(),
+    ];
+    for (k, (w, m)) in parts.iter().enumerate() {
+        h.push(format!(
+            "  {name}.{}  weight {}  ({})",
+            k + 1,
+            sig(*w, 6),
+            m.args()
+                .iter()
+                .map(|a| sig(*a, 6))
+                .collect::<Vec<_>>()
+                .join(" ")
+        ));
+    }
+    if let (Some(shape), Some(args)) = (material.shape(), material.args()) {
+        h.push(format!(
+            "Fitted arguments ({}): {}.",
+            report::argument_names(shape),
+            args.iter()
+                .map(|a| sig(*a, 6))
+                .collect::<Vec<_>>()
+                .join(" ")
+        ));
+    }
+    h.push(format!(
+        "Real arguments of each primitive: {}.",
+        report::argument_names(brtf_model::Shape::single(kind))
+    ));
+    h
 }
 
 /// The incidences the variant comparison is shown at.

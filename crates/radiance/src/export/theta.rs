@@ -21,7 +21,7 @@ use super::static_material::comment_block;
 use super::{ExportError, cal_file_name, theta_file_name};
 use crate::primitive::{Primitive, format_primitive};
 use brtf_fit::{FitResult, ParamTable};
-use brtf_model::{FTINY, Material, MaterialKind, Variant};
+use brtf_model::{Composite, FTINY, MaterialKind, Shape, Variant};
 use glam::DVec3;
 
 /// Samples per table segment when searching minima over θ_in.
@@ -49,20 +49,28 @@ pub(crate) fn build(
     name: &str,
 ) -> Result<Theta, ExportError> {
     let kind = table.kind;
+    let shape = table.shape();
+    // Plain ASCII: `metal`, `metal x2 lobes`, `plastic2 (orientation fitted)`.
+    let label = ascii(&shape.label());
     let options = result.options();
     let variant = options.variant;
     check_rows(table)?;
     let pieces = Pieces::of(table);
-    let grid = grid(table);
+    let grid = grid(table)?;
     let iso = !kind.is_anisotropic();
-    let any_pure = iso && grid.iter().any(|a| a[4] * a[4] <= FTINY);
+    let any_pure = iso
+        && grid.iter().any(|m| {
+            m.components()
+                .iter()
+                .any(|(_, p)| p.args()[4] * p.args()[4] <= FTINY)
+        });
     let azimuth = table.depends_on_azimuth();
     let lobe_only =
         variant != Variant::Ward1992 && !any_pure && !azimuth && only_roughness_varies(table);
     let entry = if lobe_only {
         Entry::Lobe
     } else {
-        let (rd0, td0) = diffuse_floor(kind, variant, &grid);
+        let (rd0, td0) = diffuse_floor(variant, &grid);
         Entry::Brtd {
             rd0,
             td0,
@@ -71,6 +79,7 @@ pub(crate) fn build(
     };
     let model = CalModel {
         kind,
+        shape,
         variant,
         fresnel_k: options.fresnel_k,
         orientation: table.orientation,
@@ -96,7 +105,7 @@ pub(crate) fn build(
             cal_name = cal_name
         ),
         format!(
-            "({kind}, variant {variant}), written by brtf {} (brtf export). Used by {}.",
+            "({label}, variant {variant}), written by brtf {} (brtf export). Used by {}.",
             env!("CARGO_PKG_VERSION"),
             theta_file_name(name)
         ),
@@ -110,7 +119,8 @@ pub(crate) fn build(
     ));
     ch.push(format!(
         "  theta_in  {}",
-        kind.param_names()
+        shape
+            .param_names()
             .iter()
             .map(|n| format!("{n:>9}"))
             .collect::<Vec<_>>()
@@ -144,7 +154,7 @@ pub(crate) fn build(
     // ---- the .rad file ----
     let mut h = vec![
         format!(
-            "{}: theta_in-dependent Radiance material \"{name}\" ({kind}, variant {variant}),",
+            "{}: theta_in-dependent Radiance material \"{name}\" ({label}, variant {variant}),",
             theta_file_name(name)
         ),
         format!(
@@ -182,12 +192,17 @@ or add the folder to RAYPATH (docs/radiance.md).
             } else {
                 "colour and\nspecularity"
             };
+            let lobes = if shape.lobes > 1 {
+                "the weighted sum of\nthe specular lobes"
+            } else {
+                "the specular lobe"
+            };
             h.extend(lines(&format!(
                 "Material: {radiance_type}. Only the roughness changes with theta_in, so the real
 arguments hold the constant {constants}, and the function {LOBE_FUNCTION} computes
-the specular lobe at the light's theta_in ({variant} formulas).
+{lobes} at the light's theta_in ({variant} formulas).
 
-What differs from a static {kind} in a rendering:
+What differs from a static {label} in a rendering:
   - the specular lobe responds to light sources only; indirect light (-ab) reaches
     the constant diffuse and specular fractions as if they were diffuse;
   - the lobe is not sampled: other objects do not appear in the glossy reflection
@@ -223,11 +238,19 @@ What differs from a static {kind} in a rendering:
             reals.extend(rd0);
             reals.extend(td0);
             h.extend(lines(&format!(
-                "Material: BRTDfunc. Its functions compute brtf-model's {kind} BSDF ({variant}
+                "Material: BRTDfunc. Its functions compute brtf-model's {label} BSDF ({variant}
 formulas) with the parameters at the light's theta_in. The real arguments are
 constant diffuse parts (front and back reflectance, then transmittance), each the
 smallest over theta_in; the functions add the rest."
             )));
+            if shape.lobes > 1 {
+                h.extend(lines(&format!(
+                    "A lobe sum: the functions add the {} {kind} lobes with their weights at the
+light's theta_in (a mixfunc coefficient cannot follow the light, so the lobes are
+summed here, in one material).",
+                    shape.lobes
+                )));
+            }
             if deltas {
                 h.extend(lines(
                     "Roughness-0 incidences: the mirror (and straight-through) coefficients use the
@@ -236,7 +259,7 @@ parameters at the view's theta, as a mirror ray would see them.",
             }
             h.extend(lines(&format!(
                 "
-What differs from a static {kind} in a rendering:
+What differs from a static {label} in a rendering:
   - the specular lobe and the theta_in-dependent part of the diffuse term respond
     to light sources only; indirect light (-ab) reaches only the constant diffuse
     parts in the real arguments;
@@ -270,7 +293,7 @@ treat other surfaces as sources (mkillum) give theta_in from those.",
         h.extend(lines(&format!(
             "
 Variant {variant}: the functions evaluate the {variant} formulas that were fitted,
-not what rtrace computes for a static {kind} with the same parameters."
+not what rtrace computes for a static {label} with the same parameters."
         )));
     }
     h.push(String::new());
@@ -288,34 +311,40 @@ fn lines(text: &str) -> Vec<String> {
     text.lines().map(str::to_string).collect()
 }
 
-/// Every table row must be a valid material of the table's type.
+/// Every table row must be a valid material of the table's shape.
 fn check_rows(table: &ParamTable) -> Result<(), ExportError> {
-    let orientation = DVec3::from_array(table.orientation);
     for (theta, args) in table.theta_in.iter().zip(&table.args) {
-        Material::new(table.kind, args, Some(orientation)).map_err(|source| {
-            ExportError::Material {
-                what: format!("the table row θ_in = {theta}"),
-                kind: table.kind,
-                source,
-            }
-        })?;
+        composite(table, args, *theta)?;
     }
     Ok(())
 }
 
-/// Interpolated arguments on a fine θ_in grid (nodes included); for a
+/// The material of the table's shape with arguments `args` (of the row or
+/// grid point at `theta`).
+fn composite(table: &ParamTable, args: &[f64], theta: f64) -> Result<Composite, ExportError> {
+    let material = |source| ExportError::Material {
+        what: format!("the table row θ_in = {theta}"),
+        kind: table.kind,
+        source,
+    };
+    let shape = Shape::new(table.kind, table.lobes, table.oriented).map_err(ExportError::Table)?;
+    Composite::new(shape, args, Some(DVec3::from_array(table.orientation))).map_err(material)
+}
+
+/// The interpolated materials on a fine θ_in grid (nodes included); for a
 /// table that follows φ_in, on a (θ_in, φ_in) grid.
-fn grid(table: &ParamTable) -> Vec<Vec<f64>> {
+fn grid(table: &ParamTable) -> Result<Vec<Composite>, ExportError> {
     let (per_segment, azimuths) = if table.depends_on_azimuth() {
         (GRID_PER_SEGMENT_WITH_AZIMUTH, GRID_AZIMUTHS)
     } else {
         (GRID_PER_SEGMENT, 1)
     };
-    let at = |t: f64, out: &mut Vec<Vec<f64>>| {
+    let at = |t: f64, out: &mut Vec<Composite>| -> Result<(), ExportError> {
         for k in 0..azimuths {
             let phi = 360.0 * k as f64 / azimuths as f64;
-            out.push(table.args_at_direction(t, phi).0);
+            out.push(composite(table, &table.args_at_direction(t, phi).0, t)?);
         }
+        Ok(())
     };
     let mut out = Vec::new();
     for w in table.theta_in.windows(2) {
@@ -323,13 +352,13 @@ fn grid(table: &ParamTable) -> Vec<Vec<f64>> {
             at(
                 w[0] + (w[1] - w[0]) * j as f64 / per_segment as f64,
                 &mut out,
-            );
+            )?;
         }
     }
     if let Some(&last) = table.theta_in.last() {
-        at(last, &mut out);
+        at(last, &mut out)?;
     }
-    out
+    Ok(out)
 }
 
 /// Indices of the transmissivity and transmitted-specular fraction.
@@ -345,7 +374,7 @@ fn trans_indices(kind: MaterialKind) -> (Option<usize>, Option<usize>) {
 fn only_roughness_varies(table: &ParamTable) -> bool {
     let first = &table.args[0];
     table
-        .kind
+        .shape()
         .param_names()
         .iter()
         .enumerate()
@@ -360,14 +389,48 @@ fn only_roughness_varies(table: &ParamTable) -> bool {
 
 /// The smallest diffuse reflectance and transmittance (per channel) over
 /// θ_in and over every view, times a small margin: the constant parts of
-/// the `BRTDfunc`.
-fn diffuse_floor(kind: MaterialKind, variant: Variant, grid: &[Vec<f64>]) -> ([f64; 3], [f64; 3]) {
+/// the `BRTDfunc`. A lobe sum's is the weighted sum of its primitives'.
+fn diffuse_floor(variant: Variant, grid: &[Composite]) -> ([f64; 3], [f64; 3]) {
     let mut rd = [f64::INFINITY; 3];
     let mut td = [f64::INFINITY; 3];
+    for material in grid {
+        let mut r = [0.0; 3];
+        let mut t = [0.0; 3];
+        for (w, m) in material.components() {
+            let (rm, tm) = primitive_diffuse_floor(m.kind(), variant, m.args());
+            for k in 0..3 {
+                r[k] += w * rm[k];
+                t[k] += w * tm[k];
+            }
+        }
+        for k in 0..3 {
+            rd[k] = rd[k].min(r[k]);
+            td[k] = td[k].min(t[k]);
+        }
+    }
+    let finish = |x: [f64; 3]| {
+        x.map(|v| {
+            if v.is_finite() {
+                (v * FLOOR_MARGIN).max(0.0)
+            } else {
+                0.0
+            }
+        })
+    };
+    (finish(rd), finish(td))
+}
+
+/// The smallest diffuse reflectance and transmittance of one primitive
+/// with real arguments `a` over every view.
+fn primitive_diffuse_floor(
+    kind: MaterialKind,
+    variant: Variant,
+    a: &[f64],
+) -> ([f64; 3], [f64; 3]) {
     // The view-dependent Fresnel terms are largest at the clamped view cosine.
     let e6 = (-6.0f64 * 0.001).exp();
     let (it, its) = trans_indices(kind);
-    for a in grid {
+    {
         let c = [a[0], a[1], a[2]];
         let rs = a[3];
         let pure = !kind.is_anisotropic() && a[4] * a[4] <= FTINY;
@@ -396,19 +459,6 @@ fn diffuse_floor(kind: MaterialKind, variant: Variant, grid: &[Vec<f64>]) -> ([f
                 c.map(|ck| if t_on { ck * t_d } else { 0.0 }),
             )
         };
-        for k in 0..3 {
-            rd[k] = rd[k].min(r[k]);
-            td[k] = td[k].min(t[k]);
-        }
+        (r, t)
     }
-    let finish = |x: [f64; 3]| {
-        x.map(|v| {
-            if v.is_finite() {
-                (v * FLOOR_MARGIN).max(0.0)
-            } else {
-                0.0
-            }
-        })
-    };
-    (finish(rd), finish(td))
 }
