@@ -2,7 +2,7 @@
 
 use super::material::MaterialArgs;
 use anyhow::Result;
-use brtf_model::{albedo, direction};
+use brtf_model::{composite_albedo, direction};
 use clap::Args;
 use std::io::{BufWriter, Write};
 
@@ -40,7 +40,7 @@ pub(crate) fn run(args: AlbedoArgs) -> Result<()> {
         "theta_in,phi_in,rho_r,rho_g,rho_b,tau_r,tau_g,tau_b,rho_spike,tau_spike"
     )?;
     for &theta in &args.theta_in {
-        let a = albedo(&bsdf, direction(theta, args.phi_in), args.tolerance);
+        let a = composite_albedo(&bsdf, direction(theta, args.phi_in), args.tolerance);
         // The delta spikes are reported as their mean over the three channels.
         let mean = |c: [f64; 3]| (c[0] + c[1] + c[2]) / 3.0;
         writeln!(

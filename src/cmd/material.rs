@@ -2,17 +2,19 @@
 
 use super::shared::words;
 use anyhow::Result;
-use brtf_model::{Bsdf, EvalOptions, Material, Variant, parse_fresnel_k};
+use brtf_model::{Composite, CompositeBsdf, EvalOptions, Variant, parse_fresnel_k};
 use brtf_workflow::read_material_file;
 use clap::Args;
 use std::path::PathBuf;
 
 #[derive(Args, Debug, Clone)]
 pub(crate) struct MaterialArgs {
-    /// Radiance file holding the material primitive(s).
+    /// Radiance file holding the material: a Ward-type primitive, or a
+    /// constant mixfunc tree of them (a lobe sum).
     #[arg(long, value_name = "M.rad")]
     pub material: PathBuf,
-    /// Which material in the file (needed when it holds several).
+    /// Which material in the file (needed when it holds several; a lobe
+    /// sum's name is its top mixfunc's).
     #[arg(long, value_name = "N")]
     pub name: Option<String>,
     #[command(flatten)]
@@ -49,8 +51,8 @@ impl FormulaArgs {
 }
 
 impl MaterialArgs {
-    /// Reads the file and picks the material.
-    pub(crate) fn load(&self) -> Result<(String, Material)> {
+    /// Reads the file and picks the material (one primitive or a lobe sum).
+    pub(crate) fn load(&self) -> Result<(String, Composite)> {
         Ok(read_material_file(&self.material, self.name.as_deref())?)
     }
 
@@ -64,8 +66,9 @@ impl MaterialArgs {
         Ok(options)
     }
 
-    pub(crate) fn bsdf(&self) -> Result<Bsdf> {
+    /// The material prepared for evaluation: `Σ w_k f_k` over its lobes.
+    pub(crate) fn bsdf(&self) -> Result<CompositeBsdf> {
         let (_, material) = self.load()?;
-        Ok(Bsdf::new(&material, &self.options()?))
+        Ok(CompositeBsdf::new(&material, &self.options()?))
     }
 }

@@ -10,7 +10,8 @@ use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub(crate) struct SynthArgs {
-    /// Ground truth: a brtf-model material (with --name, --variant, ...).
+    /// Ground truth: a brtf-model material, one primitive or a lobe sum (a
+    /// constant mixfunc tree), with --name, --variant, ...
     #[arg(long, value_name = "M.rad", conflicts_with = "ggx")]
     pub material: Option<PathBuf>,
     #[command(flatten)]
@@ -97,7 +98,12 @@ pub(crate) fn run(args: SynthArgs) -> Result<()> {
                 source_omega: 0.0,
                 curved: false,
             };
-            GroundTruth::Model(material.bsdf()?)
+            let bsdf = material.bsdf()?;
+            // One primitive as itself; a lobe sum as the sum of its lobes.
+            match bsdf.parts() {
+                [(_, one)] => GroundTruth::Model(*one),
+                _ => GroundTruth::Lobes(bsdf),
+            }
         }
         (None, Some(f0)) => {
             GroundTruth::ggx(f0, args.ggx_alpha, &args.ggx_diffuse).map_err(anyhow::Error::msg)?

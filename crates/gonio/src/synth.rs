@@ -6,7 +6,7 @@
 //! over the source and detector apertures, noise (multiplicative plus a
 //! floor), the blind spot around the incident beam, a holder-shadow gap,
 //! and noise-only back rows for opaque samples. The ground truth is any
-//! brtf-model material, or a GGX (Cook-Torrance) conductor that Radiance's
+//! brtf-model material or lobe sum, or a GGX (Cook-Torrance) conductor that Radiance's
 //! Gaussian lobe cannot fit exactly, for honest model-mismatch tests.
 //! Everything is seeded and deterministic.
 
@@ -14,16 +14,19 @@ use crate::measurement::{
     Channels, Incidence, IncidenceOrigin, Measurement, Quantity, Sample, SourceFormat,
 };
 use crate::solid_angle::compute_solid_angles;
-use brtf_model::{Bsdf, Rng, direction};
+use brtf_model::{Bsdf, CompositeBsdf, Rng, direction};
 use glam::DVec3;
 use std::f64::consts::PI;
 
 /// What the synthetic sample really is.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 #[allow(clippy::large_enum_variant)] // built once per file, never stored in bulk
 pub enum GroundTruth {
     /// A brtf-model material, evaluated with its options.
     Model(Bsdf),
+    /// A lobe sum (primitives mixed with constant weights, as a `mixfunc`
+    /// tree renders), evaluated with its options.
+    Lobes(CompositeBsdf),
     /// A GGX conductor: Trowbridge-Reitz microfacets, Schlick Fresnel,
     /// separable Smith shadowing, plus a Lambertian base.
     Ggx {
@@ -54,6 +57,7 @@ impl GroundTruth {
     pub fn eval(&self, l: DVec3, v: DVec3) -> [f64; 3] {
         match self {
             GroundTruth::Model(bsdf) => bsdf.eval(l, v),
+            GroundTruth::Lobes(bsdf) => bsdf.eval(l, v),
             GroundTruth::Ggx { f0, alpha, diffuse } => ggx(*f0, *alpha, *diffuse, l, v),
         }
     }
@@ -61,13 +65,14 @@ impl GroundTruth {
     /// The lobe's angular width in radians, to size the dense patch.
     pub fn lobe_width(&self) -> f64 {
         match self {
-            GroundTruth::Model(bsdf) => {
-                let a = bsdf.material().args();
-                let alpha = if bsdf.kind().is_anisotropic() {
-                    a[4].max(a[5])
-                } else {
-                    a[4]
-                };
+            GroundTruth::Model(bsdf) => 2.0 * widest_roughness(bsdf).max(0.005),
+            // The widest lobe: the dense patch must cover it.
+            GroundTruth::Lobes(bsdf) => {
+                let alpha = bsdf
+                    .parts()
+                    .iter()
+                    .map(|(_, b)| widest_roughness(b))
+                    .fold(0.0, f64::max);
                 2.0 * alpha.max(0.005)
             }
             GroundTruth::Ggx { alpha, .. } => 2.0 * alpha.max(0.005),
@@ -78,8 +83,19 @@ impl GroundTruth {
     pub fn transmits(&self) -> bool {
         match self {
             GroundTruth::Model(bsdf) => bsdf.kind().is_transmitting(),
+            GroundTruth::Lobes(bsdf) => bsdf.is_transmitting(),
             GroundTruth::Ggx { .. } => false,
         }
+    }
+}
+
+/// The larger roughness of one primitive (its only one, if isotropic).
+fn widest_roughness(bsdf: &Bsdf) -> f64 {
+    let a = bsdf.material().args();
+    if bsdf.kind().is_anisotropic() {
+        a[4].max(a[5])
+    } else {
+        a[4]
     }
 }
 
@@ -454,7 +470,7 @@ impl SynthSet {
     /// The text of file `index` (of `theta_in[index]`) and its sample count.
     pub fn file_text(&self, index: usize) -> Result<(String, usize), String> {
         let spec = SynthSpec {
-            truth: self.truth,
+            truth: self.truth.clone(),
             incidence: Incidence::new(self.theta_in[index], self.phi_in),
             instrument: self.instrument.clone(),
             layout: self.layout.clone(),

@@ -436,3 +436,44 @@ fn matches_bsdf2klems_on_the_same_function() {
         assert!(worst_inside <= 0.005, "{direction}: {worst_inside}");
     }
 }
+
+/// A lobe sum's Klems matrices are its lobes' matrices added with their
+/// weights (each lobe averaged on the same points), for every block.
+#[test]
+fn a_lobe_sum_s_matrices_are_its_lobes_weighted() {
+    use brtf_model::{Composite, Shape};
+    use brtf_radiance::export::klems::klems_from_composite;
+    let shape = Shape::new(MaterialKind::Plastic, 2, false).unwrap();
+    let sum = Composite::new(shape, &[0.5, 0.4, 0.3, 0.08, 0.3, 0.04, 0.2], None).unwrap();
+    let mut options = KlemsOptions::new("two");
+    options.basis = KlemsBasis::built_in("LBNL/Klems Quarter").unwrap();
+    options.sampling.samples = 16;
+    options.colour = true;
+    let eval = EvalOptions::default();
+    let of = |m: &Composite| klems_from_composite(m, &eval, "m.rad", "00", &options).unwrap();
+    let whole = of(&sum);
+    let lobes: Vec<_> = sum
+        .components()
+        .iter()
+        .map(|(w, m)| (*w, of(&Composite::from_material(m))))
+        .collect();
+    assert_eq!(
+        whole.blocks.len(),
+        6,
+        "Y, X, Z of the front and back reflection"
+    );
+    for (b, block) in whole.blocks.iter().enumerate() {
+        for (i, value) in block.values.iter().enumerate() {
+            let expected: f64 = lobes.iter().map(|(w, e)| w * e.blocks[b].values[i]).sum();
+            assert!(
+                (value - expected).abs() <= 1e-12 * expected.abs().max(1e-3),
+                "block {b} entry {i}: {value} vs {expected}"
+            );
+        }
+    }
+    assert!(
+        whole.text.contains("Lobe 2: weight 0.7"),
+        "{}",
+        &whole.text[..2000]
+    );
+}

@@ -140,8 +140,8 @@ pub fn plot_folder(
     Ok(written)
 }
 
-/// The Klems BSDF XML of the material `name` of the Radiance file `path`,
-/// written as `<out>/<name>.xml` (`out` defaults to the file's folder);
+/// The Klems BSDF XML of the material `name` of the Radiance file `path`
+/// (one primitive or a lobe sum, a constant mixfunc tree), written as `<out>/<name>.xml` (`out` defaults to the file's folder);
 /// with `with_cal` also `<name>-bsdf2klems.cal`, its BSDF as the function
 /// `bsdf2klems -f` takes.
 pub fn export_klems_of_material(
@@ -160,7 +160,7 @@ pub fn export_klems_of_material(
         source,
     })?;
     options.name = name.clone();
-    let export = klems::klems_from_material(
+    let export = klems::klems_from_composite(
         &material,
         eval,
         &path.display().to_string(),
@@ -176,7 +176,7 @@ pub fn export_klems_of_material(
     klems::write_klems(&xml, &export)?;
     let mut files = vec![xml];
     if with_cal {
-        let cal = brtf_radiance::export::klems_cal::bsdf_function_cal(&material)
+        let cal = brtf_radiance::export::klems_cal::composite_function_cal(&material)
             .map_err(|e| WorkflowError::Usage(format!("--klems-cal: {e}")))?;
         let cal_path = out.join(format!("{name}-bsdf2klems.cal"));
         brtf_io::write_atomic(&cal_path, cal.as_bytes())?;

@@ -1,15 +1,16 @@
 //! Materials from Radiance files.
 
 use crate::WorkflowError;
-use brtf_model::Material;
+use brtf_model::Composite;
 use std::path::Path;
 
 /// Reads the Radiance file `path` and picks the material `name` (or its
-/// only Ward-type material): its identifier and the material.
+/// one top material): its identifier and the material, one Ward-type
+/// primitive or a constant `mixfunc` tree of them (a lobe sum).
 pub fn read_material_file(
     path: &Path,
     name: Option<&str>,
-) -> Result<(String, Material), WorkflowError> {
+) -> Result<(String, Composite), WorkflowError> {
     let shown = path.display().to_string();
     let text = std::fs::read_to_string(path).map_err(|source| {
         WorkflowError::Io(brtf_io::IoError {
@@ -19,5 +20,5 @@ pub fn read_material_file(
         })
     })?;
     let primitives = brtf_radiance::parse_primitives(&text, &shown)?;
-    Ok(brtf_radiance::select_material(&primitives, name, &shown)?)
+    Ok(brtf_radiance::select_composite(&primitives, name, &shown)?)
 }

@@ -13,6 +13,10 @@
 //! all four, the back fit's matrices written as rb and tb. A static
 //! material is two-sided in Radiance, so it gives all four too, with the
 //! back equal to the front.
+//!
+//! A lobe sum's matrices are its lobes' matrices (each computed on the same
+//! sample points) added with the lobes' weights at each incident patch's
+//! θ_in: exactly the patch averages of `Σ w_k f_k`.
 
 use std::path::{Path, PathBuf};
 
@@ -21,7 +25,7 @@ use brtf_gonio::klems::{
     KlemsBand, KlemsBasis, KlemsDirection, KlemsWriteBlock, KlemsWriteHeader, Side, to_klems_xml,
 };
 use brtf_gonio::klems::{SampleOptions, SideMatrices, band_values, side_matrices};
-use brtf_model::{Bsdf, EvalOptions, Material, Rgb};
+use brtf_model::{Bsdf, Composite, EvalOptions, Material, Rgb};
 
 /// Where the Solar band comes from.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -34,8 +38,8 @@ pub enum SolarBand {
     /// The luminance-weighted BSDF of this static material (the user's
     /// solar properties), from the file named.
     Material {
-        /// The material.
-        material: Material,
+        /// The material (one primitive or a lobe sum).
+        material: Composite,
         /// Its file, for the header.
         source: String,
     },
@@ -130,13 +134,78 @@ pub struct KlemsExport {
     pub notes: Vec<String>,
 }
 
-/// One lit side: a material per incident patch, and where they came from.
+/// One lit side: a material per incident patch, as lobes: `lobes[k]` is
+/// lobe k's weight and BSDF at every incident patch.
 struct SideModel {
-    bsdfs: Vec<Bsdf>,
+    lobes: Vec<Lobe>,
     transmitting: bool,
     /// The same model as the front's (a two-sided material): reuse the
     /// front's matrices instead of computing them again.
     same_as_front: bool,
+}
+
+/// One lobe of a side's materials over the incident patches.
+struct Lobe {
+    weights: Vec<f64>,
+    bsdfs: Vec<Bsdf>,
+}
+
+impl SideModel {
+    /// The model of the same material at every incident patch.
+    fn uniform(material: &Composite, eval: &EvalOptions, patches: usize) -> SideModel {
+        let lobes = material
+            .components()
+            .iter()
+            .map(|(w, m)| Lobe {
+                weights: vec![*w; patches],
+                bsdfs: vec![Bsdf::new(m, eval); patches],
+            })
+            .collect();
+        SideModel {
+            lobes,
+            transmitting: material
+                .components()
+                .iter()
+                .any(|(_, m)| m.kind().is_transmitting()),
+            same_as_front: false,
+        }
+    }
+
+    /// The evaluation options of its BSDFs.
+    fn options(&self) -> Option<EvalOptions> {
+        self.lobes
+            .first()
+            .and_then(|l| l.bsdfs.first())
+            .map(|b| *b.options())
+    }
+
+    /// The Klems matrices: each lobe's, added with its weight per incident
+    /// patch (column).
+    fn matrices(&self, basis: &KlemsBasis, sampling: SampleOptions) -> SideMatrices {
+        let mut total: Option<SideMatrices> = None;
+        for lobe in &self.lobes {
+            let m = side_matrices(basis, &lobe.bsdfs, self.transmitting, sampling);
+            let n = m.n;
+            let sum = total.get_or_insert_with(|| SideMatrices {
+                n,
+                reflection: vec![[0.0; 3]; n * n],
+                transmission: m.transmission.as_ref().map(|_| vec![[0.0; 3]; n * n]),
+            });
+            let add = |to: &mut [Rgb], from: &[Rgb]| {
+                for (index, (t, f)) in to.iter_mut().zip(from).enumerate() {
+                    let w = lobe.weights[index % n];
+                    for c in 0..3 {
+                        t[c] += w * f[c];
+                    }
+                }
+            };
+            add(&mut sum.reflection, &m.reflection);
+            if let (Some(to), Some(from)) = (sum.transmission.as_mut(), m.transmission.as_ref()) {
+                add(to, from);
+            }
+        }
+        total.expect("a material has a lobe")
+    }
 }
 
 /// The fit's evaluation options for export: its variant and Fresnel
@@ -156,7 +225,7 @@ fn side_from_fit(
     basis: &KlemsBasis,
 ) -> Result<SideModel, KlemsExportError> {
     let options = export_options(result);
-    let mut bsdfs = Vec::with_capacity(basis.len());
+    let mut lobes: Vec<Lobe> = Vec::new();
     let mirrored = result.is_mirrored_side();
     for patch in basis.patches() {
         let theta = patch.theta_deg;
@@ -164,11 +233,11 @@ fn side_from_fit(
         let phi = azimuth_from_u(result.config.orientation, mirrored, patch.phi_deg + 180.0);
         let material = match &result.table {
             Some(table) => table
-                .at_direction(theta, phi)
-                .map(|l| l.material)
+                .composite_at_direction(theta, phi)
+                .map(|(m, _)| m)
                 .map_err(|e| e.to_string()),
             None => result
-                .static_material()
+                .static_composite()
                 .ok_or_else(|| "the fit holds no parameters".to_string()),
         }
         .map_err(|why| KlemsExportError::NoMaterial {
@@ -176,10 +245,24 @@ fn side_from_fit(
             theta,
             why,
         })?;
-        bsdfs.push(Bsdf::new(&material, &options));
+        let parts = material.components();
+        if lobes.is_empty() {
+            lobes = parts
+                .iter()
+                .map(|_| Lobe {
+                    weights: Vec::with_capacity(basis.len()),
+                    bsdfs: Vec::with_capacity(basis.len()),
+                })
+                .collect();
+        }
+        // One shape for the whole fit, so the same lobes at every patch.
+        for (lobe, (w, m)) in lobes.iter_mut().zip(parts) {
+            lobe.weights.push(*w);
+            lobe.bsdfs.push(Bsdf::new(m, &options));
+        }
     }
     Ok(SideModel {
-        bsdfs,
+        lobes,
         transmitting: result.config.kind.is_transmitting(),
         same_as_front: false,
     })
@@ -275,35 +358,73 @@ pub fn klems_from_material(
     source_sha256: &str,
     options: &KlemsOptions,
 ) -> Result<KlemsExport, KlemsExportError> {
-    let bsdf = Bsdf::new(material, eval);
+    klems_from_composite(
+        &Composite::from_material(material),
+        eval,
+        source,
+        source_sha256,
+        options,
+    )
+}
+
+/// A static material, one primitive or a lobe sum (a constant mixfunc
+/// tree): all four components, the back equal to the front.
+pub fn klems_from_composite(
+    material: &Composite,
+    eval: &EvalOptions,
+    source: &str,
+    source_sha256: &str,
+    options: &KlemsOptions,
+) -> Result<KlemsExport, KlemsExportError> {
     // brtf-model turns the surface towards the viewer, so light from the
     // back sees exactly the front's BSDF: the back matrices are the front's.
     let side = |same_as_front| SideModel {
-        bsdfs: vec![bsdf; options.basis.len()],
-        transmitting: material.kind().is_transmitting(),
         same_as_front,
+        ..SideModel::uniform(material, eval, options.basis.len())
     };
-    let comment = vec![
+    let list = |args: &[f64]| {
+        args.iter()
+            .map(|a| a.to_string())
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    let parts = material.components();
+    let kind = material.kind();
+    let mut comment = vec![
         format!(
             "Klems BSDF of the static Radiance {} in {source}, written by brtf {} (brtf export \
              --klems --material).",
-            material.kind(),
+            if parts.len() > 1 {
+                format!("lobe sum (mixfunc of {} primitives)", parts.len())
+            } else {
+                kind.to_string()
+            },
             env!("CARGO_PKG_VERSION")
         ),
         format!("Input: {source} sha256 {source_sha256}"),
-        format!(
+    ];
+    if let [(_, m)] = parts {
+        comment.push(format!(
             "Material: {} {}; variant {}, Fresnel K {}.",
-            material.kind(),
-            material
-                .args()
-                .iter()
-                .map(|a| a.to_string())
-                .collect::<Vec<_>>()
-                .join(" "),
+            m.kind(),
+            list(m.args()),
             eval.variant,
             eval.fresnel_k
-        ),
-    ];
+        ));
+    } else {
+        for (k, (w, m)) in parts.iter().enumerate() {
+            comment.push(format!(
+                "Lobe {}: weight {w}, {} {}.",
+                k + 1,
+                m.kind(),
+                list(m.args())
+            ));
+        }
+        comment.push(format!(
+            "Variant {}, Fresnel K {}.",
+            eval.variant, eval.fresnel_k
+        ));
+    }
     build(
         vec![(Side::Front, side(false)), (Side::Back, side(true))],
         options,
@@ -360,7 +481,7 @@ fn build(
     for (side, model) in &sides {
         let matrices = match computed.first() {
             Some((_, front)) if model.same_as_front => front.clone(),
-            _ => side_matrices(basis, &model.bsdfs, model.transmitting, options.sampling),
+            _ => model.matrices(basis, options.sampling),
         };
         computed.push((*side, matrices));
     }
@@ -410,31 +531,31 @@ fn build(
         }
         SolarBand::Material { material, source } => {
             comment.push(format!(
-                "Solar band: the luminance-weighted BSDF of the static {} in {source} (the \
+                "Solar band: the luminance-weighted BSDF of the static {}{} in {source} (the \
                  user's solar properties), the same for every incident patch.",
-                material.kind()
+                material.kind(),
+                if material.components().len() > 1 {
+                    " lobe sum"
+                } else {
+                    ""
+                }
             ));
             let eval = sides
                 .first()
-                .and_then(|(_, m)| m.bsdfs.first())
-                .map(|b| *b.options())
+                .and_then(|(_, m)| m.options())
                 .unwrap_or_default();
-            let bsdf = Bsdf::new(material, &eval);
             let transmitting = sides.iter().any(|(_, m)| m.transmitting);
-            if material.kind().is_transmitting() != transmitting {
+            let mut solar = SideModel::uniform(material, &eval, basis.len());
+            if solar.transmitting != transmitting {
                 notes.push(format!(
                     "the solar material {source} is a {}: its transmission does not match the \
                      visible components'",
                     material.kind()
                 ));
             }
+            solar.transmitting = transmitting;
             // One static material: the same matrices for both sides.
-            let m = side_matrices(
-                basis,
-                &vec![bsdf; basis.len()],
-                transmitting,
-                options.sampling,
-            );
+            let m = solar.matrices(basis, options.sampling);
             for (side, _) in &sides {
                 for (direction, rgb) in order(*side, &m) {
                     blocks.push(KlemsWriteBlock {
