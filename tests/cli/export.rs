@@ -19,7 +19,7 @@
 //! exported with `brtf export`. Run with `-- --nocapture` to see the
 //! comparison summaries.
 
-mod live;
+pub(crate) mod live;
 
 use crate::common::{brtf, close, s, temp_dir};
 use brtf_fit::{

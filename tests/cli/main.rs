@@ -18,6 +18,7 @@ mod info;
 mod klems_export;
 mod klems_fit;
 mod lobe_render;
+mod lobes;
 mod many;
 mod peer;
 mod plot;

@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
 /// Full apex angle of the test source, degrees (as in the oracle).
-pub(super) const SOURCE_APEX_DEG: f64 = 0.01;
+pub(crate) const SOURCE_APEX_DEG: f64 = 0.01;
 
 /// rtrace options giving exactly the direct term of one unjittered source
 /// sample (oracle/README.md §3).
@@ -24,7 +24,7 @@ const RTRACE_OPTIONS: &[&str] = &[
 
 /// A Radiance installation.
 #[derive(Debug, Clone)]
-pub(super) struct Radiance {
+pub(crate) struct Radiance {
     bin: PathBuf,
     /// Radiance's library folder (rayinit.cal), when known.
     lib: Option<PathBuf>,
@@ -33,7 +33,7 @@ pub(super) struct Radiance {
 
 /// What one program run printed.
 #[derive(Debug)]
-pub(super) struct Output {
+pub(crate) struct Output {
     pub stdout: Vec<u8>,
     pub stderr: String,
 }
@@ -99,7 +99,7 @@ fn in_ci() -> bool {
 }
 
 /// Radiance, or `None` after a loud warning (a failure under `CI`).
-pub(super) fn radiance_or_skip(test: &str) -> Option<Radiance> {
+pub(crate) fn radiance_or_skip(test: &str) -> Option<Radiance> {
     match locate() {
         Ok(r) => {
             eprintln!("[{test}] using Radiance from {}", r.origin);
@@ -140,7 +140,7 @@ impl Radiance {
     }
 
     /// Runs `program args...` in `dir` with `stdin`; panics on failure.
-    pub(super) fn run(&self, program: &str, dir: &Path, args: &[&str], stdin: &[u8]) -> Output {
+    pub(crate) fn run(&self, program: &str, dir: &Path, args: &[&str], stdin: &[u8]) -> Output {
         let exe = self
             .bin
             .join(format!("{program}{}", std::env::consts::EXE_SUFFIX));
@@ -177,7 +177,7 @@ impl Radiance {
     }
 
     /// `oconv files... > scene.oct` in `dir`; returns oconv's stderr.
-    pub(super) fn oconv(&self, dir: &Path, files: &[&str], octree: &str) -> String {
+    pub(crate) fn oconv(&self, dir: &Path, files: &[&str], octree: &str) -> String {
         let out = self.run("oconv", dir, files, b"");
         std::fs::write(dir.join(octree), &out.stdout).expect("write octree");
         out.stderr
@@ -185,7 +185,7 @@ impl Radiance {
 
     /// rtrace on `octree` in `dir` for `rays` (origin, direction): the
     /// radiance of each, and rtrace's stderr.
-    pub(super) fn trace(
+    pub(crate) fn trace(
         &self,
         dir: &Path,
         octree: &str,
@@ -220,7 +220,7 @@ impl Radiance {
 
 /// A distant source in direction `l` (unit) of radiance 1/ω, and one 2 × 2
 /// polygon (normal +z) per modifier, the k-th centred at (10k, 0, 0).
-pub(super) fn scene(l: [f64; 3], omega: f64, modifiers: &[String]) -> String {
+pub(crate) fn scene(l: [f64; 3], omega: f64, modifiers: &[String]) -> String {
     let radiance = 1.0 / omega;
     let mut s = format!(
         "void light test_source_light\n0\n0\n3 {radiance} {radiance} {radiance}\n\n\
@@ -241,12 +241,12 @@ pub(super) fn scene(l: [f64; 3], omega: f64, modifiers: &[String]) -> String {
 }
 
 /// The ray that sees polygon `k` from direction `v` (unit, away from it).
-pub(super) fn ray(k: usize, v: [f64; 3]) -> [f64; 6] {
+pub(crate) fn ray(k: usize, v: [f64; 3]) -> [f64; 6] {
     [10.0 * k as f64 + v[0], v[1], v[2], -v[0], -v[1], -v[2]]
 }
 
 /// The BSDF rtrace implies: radiance / (L_f32 · ω · |cos θ_in|).
-pub(super) fn bsdf_from_radiance(radiance: [f64; 3], omega: f64, light_cosine: f64) -> [f64; 3] {
+pub(crate) fn bsdf_from_radiance(radiance: [f64; 3], omega: f64, light_cosine: f64) -> [f64; 3] {
     let l32 = f64::from((1.0 / omega) as f32);
     let scale = l32 * omega * light_cosine.abs();
     radiance.map(|x| x / scale)
