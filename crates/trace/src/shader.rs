@@ -191,28 +191,24 @@ const MIN_PICK_SPEC: f64 = 0.02;
 /// One material prepared for shading: its primitives and their weights.
 #[derive(Debug, Clone)]
 struct Entry {
-    /// `(w_k, primitive k)`, weights summing to 1 (at least one).
-    parts: Vec<(f64, Primitive)>,
-    /// Several primitives: their rough lobes as mixtures, for the
-    /// orientation off and along the normal (`[normal, degenerate]`).
-    reflect: [Option<Mixture<ReflectionLobe>>; 2],
-    transmit: [Option<Mixture<TransmissionLobe>>; 2],
+    /// The first primitive (the only one of a single primitive), kept
+    /// inline: one primitive shades without a further indirection.
+    first: Primitive,
+    /// Its weight (1 alone).
+    first_weight: f64,
+    /// The other primitives of a lobe sum, `(w_k, primitive k)`; the
+    /// weights sum to 1.
+    rest: Vec<(f64, Primitive)>,
+    /// Several primitives: their rough lobes as mixtures.
+    mixtures: Option<Box<Mixtures>>,
 }
 
-/// `Σ w_k value(k)` over `parts`; one part's value as it is.
-#[inline]
-fn weighted(parts: &[(f64, Primitive)], value: impl Fn(&Primitive) -> Rgb) -> Rgb {
-    if let [(_, p)] = parts {
-        return value(p);
-    }
-    let mut sum = [0.0; 3];
-    for (w, p) in parts {
-        let f = value(p);
-        for k in 0..3 {
-            sum[k] += w * f[k];
-        }
-    }
-    sum
+/// The rough lobes of a lobe sum as mixtures, for the orientation off and
+/// along the normal (`[normal, degenerate]`).
+#[derive(Debug, Clone)]
+struct Mixtures {
+    reflect: [Option<Mixture<ReflectionLobe>>; 2],
+    transmit: [Option<Mixture<TransmissionLobe>>; 2],
 }
 
 impl Entry {
@@ -220,46 +216,69 @@ impl Entry {
     /// `reference` (see the module docs on orientations).
     fn new(material: &Composite, reference: DVec3, options: &EvalOptions) -> Entry {
         let flat = Frame::from_z_and_x(DVec3::Z, reference).unwrap_or(Frame::WORLD);
-        let parts: Vec<(f64, Primitive)> = material
-            .components()
-            .iter()
-            .map(|(w, m)| {
-                let o = m.orientation();
-                // The reference itself is x exactly (the one-material case).
-                let local = if o == reference || !m.kind().is_anisotropic() {
-                    DVec3::X
-                } else {
-                    flat.to_local(o)
-                };
-                (*w, Primitive::new(m, local, options))
-            })
-            .collect();
+        let mut parts = material.components().iter().map(|(w, m)| {
+            let o = m.orientation();
+            // The reference itself is x exactly (the one-material case).
+            let local = if o == reference || !m.kind().is_anisotropic() {
+                DVec3::X
+            } else {
+                flat.to_local(o)
+            };
+            (*w, Primitive::new(m, local, options))
+        });
+        let (first_weight, first) = parts.next().expect("a material has a primitive");
         let mut entry = Entry {
-            parts,
-            reflect: [None, None],
-            transmit: [None, None],
+            first,
+            first_weight,
+            rest: parts.collect(),
+            mixtures: None,
         };
-        if entry.parts.len() > 1 {
-            for degenerate in [false, true] {
-                let i = usize::from(degenerate);
-                entry.reflect[i] = entry.mixture(degenerate, |p, (wu, wv)| {
+        if !entry.rest.is_empty() {
+            let reflect = |degenerate| {
+                entry.mixture(degenerate, |p, (wu, wv)| {
                     (p.spec.max(MIN_PICK_SPEC), ReflectionLobe { wu, wv })
-                });
-                entry.transmit[i] = entry.mixture(degenerate, |p, (wu, wv)| {
+                })
+            };
+            let transmit = |degenerate| {
+                entry.mixture(degenerate, |p, (wu, wv)| {
                     let energy = p.trans * p.tspec;
-                    let lobe = TransmissionLobe { beta: wu.max(wv) };
-                    (
-                        if energy > 0.0 {
-                            energy.max(MIN_PICK_SPEC)
-                        } else {
-                            0.0
-                        },
-                        lobe,
-                    )
-                });
-            }
+                    let pick = if energy > 0.0 {
+                        energy.max(MIN_PICK_SPEC)
+                    } else {
+                        0.0
+                    };
+                    (pick, TransmissionLobe { beta: wu.max(wv) })
+                })
+            };
+            let mixtures = Mixtures {
+                reflect: [reflect(false), reflect(true)],
+                transmit: [transmit(false), transmit(true)],
+            };
+            entry.mixtures = Some(Box::new(mixtures));
         }
         entry
+    }
+
+    /// Every primitive with its weight.
+    fn parts(&self) -> impl Iterator<Item = (f64, &Primitive)> {
+        std::iter::once((self.first_weight, &self.first))
+            .chain(self.rest.iter().map(|(w, p)| (*w, p)))
+    }
+
+    /// `Σ w_k value(k)`; one primitive's value as it is.
+    #[inline]
+    fn weighted(&self, value: impl Fn(&Primitive) -> Rgb) -> Rgb {
+        if self.rest.is_empty() {
+            return value(&self.first);
+        }
+        let mut sum = [0.0; 3];
+        for (w, p) in self.parts() {
+            let f = value(p);
+            for k in 0..3 {
+                sum[k] += w * f[k];
+            }
+        }
+        sum
     }
 
     /// The rough lobes of the primitives of weight > 0 as a mixture, each
@@ -271,8 +290,7 @@ impl Entry {
         lobe: impl Fn(&Primitive, (f64, f64)) -> (f64, T),
     ) -> Option<Mixture<T>> {
         let weighted: Vec<(f64, T)> = self
-            .parts
-            .iter()
+            .parts()
             .filter(|(w, p)| *w > 0.0 && !p.bsdf.is_pure())
             .map(|(w, p)| {
                 let (wu, wv) = p.alpha2;
@@ -290,24 +308,25 @@ impl Entry {
 
     #[inline]
     fn eval(&self, l: DVec3, v: DVec3, degenerate: bool) -> Rgb {
-        weighted(&self.parts, |p| p.bsdf(degenerate).eval(l, v))
+        self.weighted(|p| p.bsdf(degenerate).eval(l, v))
     }
 
     #[inline]
     fn diffuse(&self, l: DVec3, v: DVec3) -> Rgb {
-        weighted(&self.parts, |p| p.diffuse(l, v))
+        self.weighted(|p| p.diffuse(l, v))
     }
 
     fn is_pure(&self) -> bool {
-        self.parts.iter().any(|(_, p)| p.bsdf.is_pure())
+        self.parts().any(|(_, p)| p.bsdf.is_pure())
     }
 
     /// The lobes for view `v`: one primitive's own; for several, the
     /// mixtures of their rough lobes when any is on for this view, the
     /// weighted sum of their deltas, and the diffuse parts of any.
+    #[inline]
     fn lobes(&self, v: DVec3, degenerate: bool) -> Lobes<'_> {
-        if let [(_, p)] = self.parts.as_slice() {
-            let one = p.lobes(v, degenerate);
+        let Some(mixtures) = &self.mixtures else {
+            let one = self.first.lobes(v, degenerate);
             return Lobes {
                 reflect: one.reflect.map(LobeMix::One),
                 transmit: one.transmit.map(LobeMix::One),
@@ -315,12 +334,12 @@ impl Entry {
                 diffuse_reflect: one.diffuse_reflect,
                 diffuse_transmit: one.diffuse_transmit,
             };
-        }
+        };
         let (mut reflect, mut transmit) = (false, false);
         let mut delta: Option<(Rgb, Rgb)> = None;
         let (mut diffuse_reflect, mut diffuse_transmit) = (false, false);
-        for (w, p) in &self.parts {
-            if *w <= 0.0 {
+        for (w, p) in self.parts() {
+            if w <= 0.0 {
                 continue;
             }
             let one = p.lobes(v, degenerate);
@@ -338,11 +357,11 @@ impl Entry {
         }
         let i = usize::from(degenerate);
         Lobes {
-            reflect: self.reflect[i]
+            reflect: mixtures.reflect[i]
                 .as_ref()
                 .filter(|_| reflect)
                 .map(LobeMix::Many),
-            transmit: self.transmit[i]
+            transmit: mixtures.transmit[i]
                 .as_ref()
                 .filter(|_| transmit)
                 .map(LobeMix::Many),
@@ -522,7 +541,7 @@ impl Shader {
 
     /// The material type (of the first primitive of a mixture).
     pub fn kind(&self) -> MaterialKind {
-        self.entries[0].parts[0].1.kind
+        self.entries[0].first.kind
     }
 
     /// True when some primitive is anisotropic (the frame follows the
@@ -538,7 +557,7 @@ impl Shader {
 
     /// Primitives per material: 1, or a lobe sum's lobes.
     pub fn lobe_count(&self) -> usize {
-        self.entries[0].parts.len()
+        1 + self.entries[0].rest.len()
     }
 
     /// True if the material (or some θ_in of a table) has roughness 0, so
@@ -551,10 +570,8 @@ impl Shader {
     /// for a table or a lobe sum), for batch evaluation: [`Self::eval`]
     /// with `degenerate = false` is this BSDF's `eval`.
     pub(crate) fn single_bsdf(&self) -> Option<&Bsdf> {
-        match (self.step, self.entries[0].parts.as_slice()) {
-            (None, [(_, p)]) => Some(&p.bsdf),
-            _ => None,
-        }
+        let entry = &self.entries[0];
+        (self.step.is_none() && entry.rest.is_empty()).then_some(&entry.first.bsdf)
     }
 
     /// The primitives of a single-material shader with their weights
@@ -563,7 +580,7 @@ impl Shader {
     pub(crate) fn part_bsdfs(&self) -> Option<impl Iterator<Item = (f64, &Bsdf)>> {
         self.step
             .is_none()
-            .then(|| self.entries[0].parts.iter().map(|(w, p)| (*w, &p.bsdf)))
+            .then(|| self.entries[0].parts().map(|(w, p)| (w, &p.bsdf)))
     }
 
     /// True for a θ_in-table shader.
