@@ -3,7 +3,8 @@
 //!
 //! `images_match_live_rpict` renders the picture scene (a sphere on a
 //! ring under a 0.2° distant source, direct light only) with brtf and
-//! writes the same scene and view as Radiance text (`--radiance`); real
+//! writes the same scene and view as Radiance text (`--radiance`), for
+//! single primitives and lobe sums (constant `mixfunc` trees); real
 //! `oconv` + `rpict -ab 0 -av 0 0 0 -st 1 -ps 1 -pj 0 -dj 0` renders it
 //! too. The mean relative pixel difference over the pixels both lit must
 //! be ≤ 2%. Radiance is looked up as in `rtrace.rs`: `$RADIANCE_BIN`,
@@ -20,7 +21,13 @@ const MATERIALS: &str = "\
 void plastic red\n0\n0\n5 0.7 0.2 0.15 0.05 0.08\n\n\
 void metal alu\n0\n0\n5 0.9 0.85 0.8 0.9 0.12\n\n\
 void trans paper\n0\n0\n7 0.8 0.8 0.75 0.03 0.15 0.5 0.3\n\n\
-void metal2 brushed\n4 1 0.3 0 .\n0\n6 0.85 0.85 0.9 0.8 0.25 0.06\n";
+void metal2 brushed\n4 1 0.3 0 .\n0\n6 0.85 0.85 0.9 0.8 0.25 0.06\n\n\
+void metal alu.sharp\n0\n0\n5 0.9 0.85 0.8 0.9 0.05\n\n\
+void metal alu.wide\n0\n0\n5 0.9 0.85 0.8 0.9 0.25\n\n\
+void mixfunc alu2\n4 alu.sharp alu.wide 0.35 .\n0\n0\n\n\
+void plastic2 grain.1\n4 1 0.3 0 .\n0\n6 0.6 0.5 0.4 0.06 0.05 0.2\n\n\
+void plastic2 grain.2\n4 1 0.3 0 .\n0\n6 0.6 0.5 0.4 0.06 0.3 0.1\n\n\
+void mixfunc grain\n4 grain.1 grain.2 0.4 .\n0\n0\n";
 
 /// Runs `brtf` with whitespace-separated arguments (temporary paths have no spaces).
 fn brtf_words(line: &str) -> common::Run {
@@ -36,7 +43,8 @@ fn materials(dir: &Path) -> PathBuf {
 fn gonio_with_point_apertures_equals_eval() {
     let dir = temp_dir();
     let m = materials(dir.path());
-    for name in ["red", "paper", "brushed"] {
+    // One primitive each, and two lobe sums (mixfunc trees).
+    for name in ["red", "paper", "brushed", "alu2", "grain"] {
         let csv = parse_csv(
             &brtf_words(&format!(
                 "render gonio --material {} --name {} --theta-in 30 --phi-in 10 --source-apex 0.01 --detector-apex 0.01 --theta-step 10 --phi-step 45 --back --samples 64",
@@ -228,7 +236,7 @@ fn parse_csv_with_text(text: &str) -> Vec<std::collections::HashMap<String, Stri
 // Against real rpict
 // ---------------------------------------------------------------------------
 
-struct Radiance {
+pub(crate) struct Radiance {
     bin: PathBuf,
     raypath: Option<OsString>,
 }
@@ -280,7 +288,7 @@ fn in_ci() -> bool {
     std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "0" && !v.eq_ignore_ascii_case("false"))
 }
 
-fn radiance_or_skip(test: &str) -> Option<Radiance> {
+pub(crate) fn radiance_or_skip(test: &str) -> Option<Radiance> {
     match locate() {
         Ok(r) => Some(r),
         Err(searched) if in_ci() => {
@@ -319,6 +327,88 @@ impl Radiance {
     }
 }
 
+/// Renders `dir/STEM.rad` (written by `brtf render image --radiance`)
+/// with real `oconv` + `rpict` at its view (direct light only) and
+/// returns the mean relative luminance difference of brtf's `STEM.hdr`
+/// over the pixels lit in both, after checking that most pixels are lit
+/// in both and few in one only.
+pub(crate) fn rpict_difference(
+    radiance: &Radiance,
+    dir: &Path,
+    stem: &str,
+    (w, h): (usize, usize),
+) -> f64 {
+    let oct = radiance.run(dir, "oconv", &[&format!("{stem}.rad")]);
+    std::fs::write(dir.join(format!("{stem}.oct")), oct).unwrap();
+    let (x, y) = (w.to_string(), h.to_string());
+    let pic = radiance.run(
+        dir,
+        "rpict",
+        &[
+            "-vf",
+            &format!("{stem}.vf"),
+            "-x",
+            &x,
+            "-y",
+            &y,
+            "-pa",
+            "0",
+            "-ab",
+            "0",
+            "-av",
+            "0",
+            "0",
+            "0",
+            "-st",
+            "1",
+            "-ps",
+            "1",
+            "-pj",
+            "0",
+            "-dj",
+            "0",
+            "-ds",
+            "0",
+            "-dv-",
+            &format!("{stem}.oct"),
+        ],
+    );
+    let theirs = brtf_trace::hdr::read(&mut &pic[..]).expect("rpict picture");
+    let ours =
+        brtf_trace::hdr::read(&mut &std::fs::read(dir.join(format!("{stem}.hdr"))).unwrap()[..])
+            .unwrap();
+    assert_eq!((theirs.width, theirs.height), (w, h), "rpict resolution");
+    let peak = theirs.pixels.iter().map(|&p| lum(p)).fold(0.0, f64::max);
+    let (mut sum, mut n, mut only) = (0.0, 0usize, 0usize);
+    for (a, b) in ours.pixels.iter().zip(&theirs.pixels) {
+        let (la, lb) = (lum(*a), lum(*b));
+        let lit = |x: f64| x > 1e-4 * peak;
+        match (lit(la), lit(lb)) {
+            (true, true) => {
+                sum += (la - lb).abs() / lb;
+                n += 1;
+            }
+            (false, false) => {}
+            _ => only += 1,
+        }
+    }
+    let mean = sum / n as f64;
+    eprintln!(
+        "rpict vs brtf-trace, {stem}: {n} pixels lit in both, {only} in one only, mean relative difference {:.3}%",
+        100.0 * mean
+    );
+    assert!(n > w * h / 4, "{stem}: only {n} pixels lit in both");
+    assert!(
+        only < w * h / 100,
+        "{stem}: {only} pixels lit in one picture only"
+    );
+    assert!(
+        mean <= 0.02,
+        "{stem}: mean relative pixel difference {mean}"
+    );
+    mean
+}
+
 /// Radiance's luminance of an RGB pixel.
 fn lum(p: [f32; 3]) -> f64 {
     0.265 * p[0] as f64 + 0.670 * p[1] as f64 + 0.065 * p[2] as f64
@@ -343,6 +433,9 @@ fn images_match_live_rpict() {
         ("brushed", "distant", "300"),
         ("red", "sphere", "300"),
         ("alu", "sphere", "300"),
+        // Lobe sums: rpict renders their mixfunc trees.
+        ("alu2", "distant", "300"),
+        ("grain", "distant", "300"),
     ] {
         let prefix = dir.path().join(format!("{name}-{light}"));
         brtf_words(&format!(
@@ -351,75 +444,7 @@ fn images_match_live_rpict() {
             ))
         .ok();
         let stem = format!("{name}-{light}");
-        let oct = radiance.run(dir.path(), "oconv", &[&format!("{stem}.rad")]);
-        std::fs::write(dir.path().join(format!("{stem}.oct")), oct).unwrap();
-        let (x, y) = (w.to_string(), h.to_string());
-        let pic = radiance.run(
-            dir.path(),
-            "rpict",
-            &[
-                "-vf",
-                &format!("{stem}.vf"),
-                "-x",
-                &x,
-                "-y",
-                &y,
-                "-pa",
-                "0",
-                "-ab",
-                "0",
-                "-av",
-                "0",
-                "0",
-                "0",
-                "-st",
-                "1",
-                "-ps",
-                "1",
-                "-pj",
-                "0",
-                "-dj",
-                "0",
-                "-ds",
-                "0",
-                "-dv-",
-                &format!("{stem}.oct"),
-            ],
-        );
-        let theirs = brtf_trace::hdr::read(&mut &pic[..]).expect("rpict picture");
-        let ours = brtf_trace::hdr::read(
-            &mut &std::fs::read(dir.path().join(format!("{stem}.hdr"))).unwrap()[..],
-        )
-        .unwrap();
-        assert_eq!((theirs.width, theirs.height), (w, h), "rpict resolution");
-        let peak = theirs.pixels.iter().map(|&p| lum(p)).fold(0.0, f64::max);
-        let (mut sum, mut n, mut only) = (0.0, 0usize, 0usize);
-        for (a, b) in ours.pixels.iter().zip(&theirs.pixels) {
-            let (la, lb) = (lum(*a), lum(*b));
-            let lit = |x: f64| x > 1e-4 * peak;
-            match (lit(la), lit(lb)) {
-                (true, true) => {
-                    sum += (la - lb).abs() / lb;
-                    n += 1;
-                }
-                (false, false) => {}
-                _ => only += 1,
-            }
-        }
-        let mean = sum / n as f64;
-        eprintln!(
-            "rpict vs brtf-trace, {stem}: {n} pixels lit in both, {only} in one only, mean relative difference {:.3}%",
-            100.0 * mean
-        );
-        assert!(n > w * h / 4, "{stem}: only {n} pixels lit in both");
-        assert!(
-            only < w * h / 100,
-            "{stem}: {only} pixels lit in one picture only"
-        );
-        assert!(
-            mean <= 0.02,
-            "{stem}: mean relative pixel difference {mean}"
-        );
+        let mean = rpict_difference(&radiance, dir.path(), &stem, (w, h));
         worst = worst.max(mean);
     }
     eprintln!(

@@ -4,7 +4,7 @@
 use crate::WorkflowError;
 use brtf_fit::FitResult;
 use brtf_gonio::{Channels, Measurement, SourceFormat};
-use brtf_model::{Composite, EvalOptions, Material, Variant};
+use brtf_model::{Composite, EvalOptions, Variant};
 use brtf_trace::Shader;
 use brtf_trace::{GonioSetup, GonioValue, RayCounts, SceneSpec, VirtualGonio};
 use std::path::{Path, PathBuf};
@@ -42,24 +42,6 @@ pub struct RenderMaterial {
     pub fit: Option<FitResult>,
 }
 
-/// What the `.rad` reader gives, as a [`Composite`] (one primitive or a
-/// constant `mixfunc` tree of them).
-trait IntoComposite {
-    fn into_composite(self) -> Composite;
-}
-
-impl IntoComposite for Material {
-    fn into_composite(self) -> Composite {
-        Composite::from_material(&self)
-    }
-}
-
-impl IntoComposite for Composite {
-    fn into_composite(self) -> Composite {
-        self
-    }
-}
-
 /// Loads `source` for the tracer: a fit folder of any shape (one
 /// primitive, a lobe sum, a fitted orientation) or a `.rad` material.
 /// `variant` and `fresnel_k` override the fit's (default: radiance and
@@ -72,12 +54,7 @@ pub fn load_render_material(
     let (name, material, fit, mut options) = match source {
         MaterialSource::File { path, name } => {
             let (name, material) = crate::read_material_file(path, name.as_deref())?;
-            (
-                name,
-                material.into_composite(),
-                None,
-                EvalOptions::default(),
-            )
+            (name, material, None, EvalOptions::default())
         }
         MaterialSource::Fit { dir, .. } => {
             let fit = crate::read_fit(dir)?;
@@ -313,24 +290,15 @@ pub fn render_image(
             "a number above 0",
         )?;
     }
-    // The static material as Radiance text, for `--radiance`.
-    let primitive_text = match (request.radiance, material.material.single()) {
-        (false, _) => None,
-        (true, Some(m)) => Some(brtf_radiance::format_primitive(
-            &brtf_radiance::primitive_from_material(m, brtf_trace::MATERIAL_NAME),
-        )),
-        (true, None) => {
-            let shape = material
-                .material
-                .shape()
-                .map_or_else(|| "a mixture".to_string(), |s| s.label());
-            return Err(WorkflowError::Usage(format!(
-                "--radiance writes one Radiance primitive, and {} is a lobe sum ({shape}); \
-                 render it without --radiance (brtf-trace renders lobe sums)",
-                material.name
-            )));
-        }
-    };
+    // The static material as Radiance text, for `--radiance`: one
+    // primitive, or a lobe sum's primitives and its mixfunc tree.
+    let primitive_text = request.radiance.then(|| {
+        brtf_radiance::composite_primitives(&material.material, brtf_trace::MATERIAL_NAME)
+            .iter()
+            .map(brtf_radiance::format_primitive)
+            .collect::<Vec<_>>()
+            .join("\n")
+    });
     let inputs: Vec<&Path> = material_file.into_iter().collect();
     for ext in [".hdr", ".png", ".rad", ".vf"] {
         brtf_io::check_overwrite(&with_extension(prefix, ext), &inputs, None, false)?;

@@ -92,7 +92,8 @@ pub(crate) struct ImageArgs {
     /// PNG exposure multiplier [default: automatic].
     #[arg(long)]
     pub exposure: Option<f64>,
-    /// Also write PREFIX.rad (scene) and PREFIX.vf (view) for rpict.
+    /// Also write PREFIX.rad (scene, with the static material: a lobe sum
+    /// as its primitives and mixfunc tree) and PREFIX.vf (view) for rpict.
     #[arg(long)]
     pub radiance: bool,
     /// Worker threads [default: all cores].

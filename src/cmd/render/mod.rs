@@ -38,7 +38,8 @@ pub(crate) fn run(args: RenderArgs) -> Result<()> {
 /// Where the material comes from.
 #[derive(Args, Debug, Clone)]
 pub(crate) struct SampleMaterial {
-    /// Radiance file holding the material primitive(s).
+    /// Radiance file holding the material: a Ward-type primitive, or a
+    /// constant mixfunc tree of them (a lobe sum).
     #[arg(
         long,
         value_name = "M.rad",
@@ -46,10 +47,12 @@ pub(crate) struct SampleMaterial {
         conflicts_with = "fit"
     )]
     pub material: Option<PathBuf>,
-    /// Which material in the file (needed when it holds several).
+    /// Which material in the file (needed when it holds several; a lobe
+    /// sum's name is its top mixfunc's).
     #[arg(long, value_name = "N")]
     pub name: Option<String>,
-    /// A fit folder (fit.json): render its θ_in-interpolated material.
+    /// A fit folder (fit.json): render its θ_in-interpolated material (of
+    /// any shape: lobe sums, fitted orientations).
     #[arg(long, value_name = "DIR")]
     pub fit: Option<PathBuf>,
     /// With --fit: the one all-incidence material instead of the θ_in table.
