@@ -139,6 +139,20 @@ fn gonio_errors_are_clear() {
     ))
     .err();
     assert!(err.contains("not both"), "{err}");
+    // A mixture of two anisotropic primitives turned differently.
+    let mixed = write_file(
+        dir.path(),
+        "mixed.rad",
+        "void metal2 u\n4 1 0 0 .\n0\n6 0.8 0.8 0.8 0.9 0.3 0.05\n\n\
+         void metal2 v\n4 0 1 0 .\n0\n6 0.8 0.8 0.8 0.9 0.3 0.05\n\n\
+         void mixfunc uv\n4 u v 0.5 .\n0\n0\n",
+    );
+    let err = brtf_words(&format!(
+        "render gonio --material {} --theta-in 30",
+        s(&mixed)
+    ))
+    .err();
+    assert!(err.contains("different orientation vectors"), "{err}");
 }
 
 #[test]

@@ -5,14 +5,14 @@
 //! (equation (1) of "Behavior of Materials in RADIANCE") prescribes, in
 //! two instruments:
 //!
-//! * the **virtual gonio-photometer** ([`gonio`]): a flat sample, a beam of
+//! * the **virtual gonio-photometer** ([`VirtualGonio`]): a flat sample, a beam of
 //!   finite solid angle at (θ_in, φ_in) and a detector with an aperture at
 //!   every measured (θ_out, φ_out); it returns the rendered BSDF per
 //!   sample as a [`brtf_gonio::Measurement`];
-//! * **pictures** ([`image`]): the material on a sphere and a plane under a
+//! * **pictures** ([`render`]): the material on a sphere and a plane under a
 //!   source, through a pinhole camera with Radiance's view parameters,
 //!   written as Radiance HDR ([`hdr`]) and tone-mapped PNG; the picture
-//!   scene of `brtf render image` is a [`SceneSpec`] ([`scene_spec`]),
+//!   scene of `brtf render image` is a [`SceneSpec`],
 //!   which also writes itself as Radiance text for `rpict`.
 //!
 //! ## Equation (1), as traced here
@@ -23,9 +23,9 @@
 //!   `Ω_i` with the whole BSDF `f` (brtf-model, evaluated for a point
 //!   source: the source's extent is integrated, not modelled by widening);
 //! * the specular part `f_s = f − f_d` is integrated with rays
-//!   importance-sampled from the Gaussian lobes ([`sampling`]; a lobe
-//!   sum's lobes as a mixture); roughness-0 surfaces trace their mirror
-//!   and straight-through rays;
+//!   importance-sampled from the Gaussian lobes ([`ReflectionLobe`],
+//!   [`TransmissionLobe`]; a lobe sum's lobes as a [`Mixture`]);
+//!   roughness-0 surfaces trace their mirror and straight-through rays;
 //! * the diffuse part `f_d` optionally gets one bounce.
 //!
 //! A material is a [`brtf_model::Composite`]: one Radiance primitive, or

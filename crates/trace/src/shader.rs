@@ -382,7 +382,8 @@ pub enum ShaderError {
     /// Anisotropic primitives with different orientation vectors.
     #[error(
         "the anisotropic primitives of a mixture have different orientation vectors \
-         ({0:?} and {1:?}): brtf-trace renders mixtures of one orientation"
+         ({} {} {} and {} {} {}): brtf-trace renders mixtures of one orientation",
+        .0[0], .0[1], .0[2], .1[0], .1[1], .1[2]
     )]
     Orientations([f64; 3], [f64; 3]),
 }
