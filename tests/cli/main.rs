@@ -22,6 +22,7 @@ mod lobes;
 mod many;
 mod peer;
 mod plot;
+mod recovery;
 mod render;
 mod reproduce;
 mod rtrace;
