@@ -114,6 +114,13 @@ fn check_of_a_two_lobe_fit_renders_the_model_and_the_fit_s_misfit() {
     let (gap_one, gap_two) = (misfit_gap(&one_rows), misfit_gap(&two_rows));
     eprintln!("render-vs-data vs the fit's RMS: one lobe {gap_one:.1e}, two lobes {gap_two:.1e}");
     assert!(gap_one < 1e-4 && gap_two < 1e-4, "{gap_one} {gap_two}");
+    // So is its E1, the share of the measured light in the wrong place.
+    for row in one_rows.iter().chain(&two_rows) {
+        if row["kind"] == "fitted" {
+            let (fit, render) = (get(row, "fit_e1"), get(row, "render_vs_data_e1"));
+            assert!(fit > 0.01 && (render - fit).abs() <= 1e-4 * fit, "{row:?}");
+        }
+    }
     // And the second lobe fits these scans better than one.
     for (a, b) in one_rows.iter().zip(&two_rows) {
         if a["kind"] == "fitted" {

@@ -13,6 +13,11 @@
 //!   widening); differences show what the formula's approximations cost;
 //! * the fit's own **model vs measured** RMS, for reference.
 //!
+//! Beside the RMS it gives E1, the share of the measured light put in the
+//! wrong place (`Σ ω |a − d| / Σ ω |d|`, with the fit's sample weights and,
+//! for files that hold BSDF × |cos θ_out|, that cosine), for the rendered
+//! material against the data and the fit's own.
+//!
 //! The fit may be of any shape: one primitive, a lobe sum (the model is
 //! brtf-model's `CompositeBsdf`, the render the [`Shader`] of the lobes)
 //! or an anisotropic type with its orientation fitted (the frame turns
@@ -148,6 +153,11 @@ pub struct CheckRow {
     pub n: usize,
     /// The fit's model-vs-data RMS (fitted incidences).
     pub fit_rms: Option<f64>,
+    /// The fit's E1 (fitted incidences; over all its samples).
+    pub fit_e1: Option<f64>,
+    /// E1 of the rendered material against the data (over the rendered
+    /// directions).
+    pub render_vs_data_e1: Option<f64>,
     /// RMS relative difference, rendered vs measured.
     pub render_vs_data_rms: Option<f64>,
     /// RMS relative difference, rendered vs model.
@@ -194,6 +204,9 @@ struct Directions {
     weights: Vec<f64>,
     /// Measured BSDF per direction (÷ the fit's scale), `channels` used.
     measured: Option<Vec<Rgb>>,
+    /// E1's weight per direction: the fit's sample weight, times |cos θ_out|
+    /// when the file's quantity holds it (empty without data).
+    e1_weights: Vec<f64>,
     channels: usize,
     /// The floor of relative differences, in BSDF units.
     floor: f64,
@@ -239,6 +252,7 @@ pub fn check_fit(
             .ok_or(CheckError::NoMaterial)?;
         let mut row = render(&material, &directions, RowKind::Fitted);
         row.fit_rms = Some(report.rms_rel);
+        row.fit_e1 = report.e1;
         row.data_missing = directions.measured.is_none();
         rows.push(row);
         fitted.push(directions);
@@ -261,6 +275,7 @@ pub fn check_fit(
                     dirs: lo.dirs.clone(),
                     weights: lo.weights.clone(),
                     measured: None,
+                    e1_weights: Vec::new(),
                     channels: lo.channels,
                     floor: 0.5 * (lo.floor + hi.floor),
                 };
@@ -330,6 +345,21 @@ fn fitted_directions(
         .div_ceil(options.max_directions.max(1))
         .max(1);
     let samples: Vec<_> = prepared.fitted().step_by(stride).map(|(_, s)| s).collect();
+    // The fitter's view of the same samples (in the same order): E1's weights.
+    let fitted = prepared.incidence_data();
+    let e1_weights = fitted
+        .samples
+        .iter()
+        .step_by(stride)
+        .map(|s| {
+            let cosine = if fitted.cosine_weighted {
+                s.view.z.abs()
+            } else {
+                1.0
+            };
+            s.weight.max(0.0) * cosine
+        })
+        .collect();
     Ok(Directions {
         theta_in: report.theta_in,
         phi_in: report.phi_in,
@@ -347,6 +377,7 @@ fn fitted_directions(
                 })
                 .collect(),
         ),
+        e1_weights,
         channels,
         floor,
     })
@@ -368,6 +399,7 @@ fn model_grid(report: &FitReport, floor: f64, mask_deg: f64) -> Directions {
             dirs,
             weights: vec![1.0; n],
             measured: None,
+            e1_weights: Vec::new(),
             channels: 3,
             floor,
         },
@@ -390,6 +422,10 @@ fn mask_beam(mut d: Directions, half_angle_deg: f64) -> Directions {
     if let Some(m) = &mut d.measured {
         let mut flags = keep.iter();
         m.retain(|_| *flags.next().expect("same length"));
+    }
+    if !d.e1_weights.is_empty() {
+        let mut flags = keep.iter();
+        d.e1_weights.retain(|_| *flags.next().expect("same length"));
     }
     d
 }
@@ -428,20 +464,29 @@ fn compare(
         }
     }
     let n = count.max(1) as f64;
-    let (render_vs_data_rms, render_data_ratio) = match &d.measured {
+    let (render_vs_data_rms, render_data_ratio, render_vs_data_e1) = match &d.measured {
         Some(data) => {
             let (mut sum, mut energy_data) = (0.0, 0.0);
+            let (mut misfit, mut light) = (0.0, 0.0);
             for (i, (r, y)) in rendered.iter().zip(data).enumerate() {
                 let w = d.weights[i] * d.dirs[i].z.abs();
+                let e1_weight = d.e1_weights.get(i).copied().unwrap_or(0.0);
                 for c in 0..channels {
                     let diff = rel(r.bsdf[c], y[c]);
                     sum += diff * diff;
                     energy_data += w * y[c];
+                    misfit += e1_weight * (r.bsdf[c] - y[c]).abs();
+                    light += e1_weight * y[c].abs();
                 }
             }
-            (Some((sum / n).sqrt()), Some(energy_rendered / energy_data))
+            let e1 = (light > 0.0).then(|| misfit / light);
+            (
+                Some((sum / n).sqrt()),
+                Some(energy_rendered / energy_data),
+                e1,
+            )
         }
-        None => (None, None),
+        None => (None, None, None),
     };
     CheckRow {
         theta_in: d.theta_in,
@@ -449,6 +494,8 @@ fn compare(
         kind,
         n: d.dirs.len(),
         fit_rms: None,
+        fit_e1: None,
+        render_vs_data_e1,
         render_vs_data_rms,
         render_vs_model_rms: (sum_rm / n).sqrt(),
         render_vs_model_max: max_rm,
@@ -470,6 +517,8 @@ impl CheckReport {
             "n",
             "fit_rms_rel",
             "render_vs_data_rms_rel",
+            "fit_e1",
+            "render_vs_data_e1",
             "render_vs_model_rms_rel",
             "render_vs_model_max_rel",
             "render_data_energy_ratio",
@@ -485,6 +534,8 @@ impl CheckReport {
                 r.n.to_string(),
                 o(r.fit_rms),
                 o(r.render_vs_data_rms),
+                o(r.fit_e1),
+                o(r.render_vs_data_e1),
                 r.render_vs_model_rms.to_string(),
                 r.render_vs_model_max.to_string(),
                 o(r.render_data_ratio),
@@ -502,6 +553,8 @@ impl CheckReport {
 impl std::fmt::Display for CheckReport {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let opt = |x: Option<f64>| x.map_or_else(|| "-".to_string(), |v| format!("{v:.4}"));
+        let percent =
+            |x: Option<f64>| x.map_or_else(|| "-".to_string(), |v| format!("{:.1}%", 100.0 * v));
         writeln!(
             f,
             "brtf check {}: {} ({}); relative differences (a − b)/sqrt(b² + floor²)",
@@ -512,12 +565,14 @@ impl std::fmt::Display for CheckReport {
         let mut s = String::new();
         let _ = writeln!(
             s,
-            "{:>8} {:>7} {:<12} {:>6} {:>9} {:>12} {:>13} {:>13} {:>11} {:>12} {:>8}",
+            "{:>8} {:>7} {:<12} {:>6} {:>9} {:>12} {:>7} {:>12} {:>13} {:>13} {:>11} {:>12} {:>8}",
             "theta_in",
             "phi_in",
             "kind",
             "n",
             "fit rms",
+            "render-data",
+            "fit E1",
             "render-data",
             "render-model",
             "render-model",
@@ -527,19 +582,21 @@ impl std::fmt::Display for CheckReport {
         );
         let _ = writeln!(
             s,
-            "{:>8} {:>7} {:<12} {:>6} {:>9} {:>12} {:>13} {:>13} {:>11} {:>12} {:>8}",
-            "", "", "", "", "", "rms", "rms", "max", "render/data", "render/model", "rms"
+            "{:>8} {:>7} {:<12} {:>6} {:>9} {:>12} {:>7} {:>12} {:>13} {:>13} {:>11} {:>12} {:>8}",
+            "", "", "", "", "", "rms", "", "E1", "rms", "max", "render/data", "render/model", "rms"
         );
         for r in &self.rows {
             let _ = writeln!(
                 s,
-                "{:>8.2} {:>7.2} {:<12} {:>6} {:>9} {:>12} {:>13.4} {:>13.4} {:>11} {:>12.4} {:>8.4}{}",
+                "{:>8.2} {:>7.2} {:<12} {:>6} {:>9} {:>12} {:>7} {:>12} {:>13.4} {:>13.4} {:>11} {:>12.4} {:>8.4}{}",
                 r.theta_in,
                 r.phi_in,
                 r.kind.to_string(),
                 r.n,
                 opt(r.fit_rms),
                 opt(r.render_vs_data_rms),
+                percent(r.fit_e1),
+                percent(r.render_vs_data_e1),
                 r.render_vs_model_rms,
                 r.render_vs_model_max,
                 opt(r.render_data_ratio),
