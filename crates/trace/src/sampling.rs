@@ -343,8 +343,9 @@ impl<T: DirectionSampler> Mixture<T> {
     }
 
     /// A direction: a lobe picked by `u[0]`, which is then stretched back
-    /// to [0, 1) for the lobe's own sampler.
-    #[inline]
+    /// to [0, 1) for the lobe's own sampler. (Out of line, as
+    /// [`Self::pdf`]: the tracer's one-lobe path stays small.)
+    #[inline(never)]
     pub fn sample(&self, v: DVec3, u: [f64; 2]) -> DVec3 {
         let n = self.lobes.len();
         let k = self.cumulative[..n - 1]
@@ -357,7 +358,7 @@ impl<T: DirectionSampler> Mixture<T> {
     }
 
     /// The mixture's density at `l`, per unit solid angle.
-    #[inline]
+    #[inline(never)]
     pub fn pdf(&self, v: DVec3, l: DVec3) -> f64 {
         self.lobes().map(|(p, lobe)| p * lobe.pdf(v, l)).sum()
     }

@@ -101,8 +101,6 @@ struct Primitive {
     kind: MaterialKind,
     /// The specularity argument (before any Fresnel estimate).
     spec: f64,
-    /// The transmissivity argument (0 for the opaque types).
-    trans: f64,
     tspec: f64,
     alpha2: (f64, f64),
     variant: Variant,
@@ -118,10 +116,10 @@ impl Primitive {
         let degenerate = kind
             .is_anisotropic()
             .then(|| Material::new(kind, args, Some(DVec3::Z)).expect("valid material"));
-        let (trans, tspec) = match kind {
-            MaterialKind::Trans => (args[5], args[6]),
-            MaterialKind::Trans2 => (args[6], args[7]),
-            _ => (0.0, 0.0),
+        let tspec = match kind {
+            MaterialKind::Trans => args[6],
+            MaterialKind::Trans2 => args[7],
+            _ => 0.0,
         };
         let alpha2 = if kind.is_anisotropic() {
             (args[4] * args[4], args[5] * args[5])
@@ -133,7 +131,6 @@ impl Primitive {
             degenerate: degenerate.map(|m| Bsdf::new(&m, options)),
             kind,
             spec: material.spec(),
-            trans,
             tspec,
             alpha2,
             variant: options.variant,
@@ -192,23 +189,48 @@ const MIN_PICK_SPEC: f64 = 0.02;
 #[derive(Debug, Clone)]
 struct Entry {
     /// The first primitive (the only one of a single primitive), kept
-    /// inline: one primitive shades without a further indirection.
+    /// inline: one primitive shades as it did alone.
     first: Primitive,
-    /// Its weight (1 alone).
-    first_weight: f64,
-    /// The other primitives of a lobe sum, `(w_k, primitive k)`; the
-    /// weights sum to 1.
-    rest: Vec<(f64, Primitive)>,
-    /// Several primitives: their rough lobes as mixtures.
-    mixtures: Option<Box<Mixtures>>,
+    /// The rest of a lobe sum.
+    sum: Option<Box<LobeSum>>,
 }
 
-/// The rough lobes of a lobe sum as mixtures, for the orientation off and
-/// along the normal (`[normal, degenerate]`).
+/// What a lobe sum adds to its first primitive.
 #[derive(Debug, Clone)]
-struct Mixtures {
+struct LobeSum {
+    /// The first primitive's weight.
+    first_weight: f64,
+    /// The other primitives, `(w_k, primitive k)`; the weights sum to 1.
+    rest: Vec<(f64, Primitive)>,
+    /// The rough lobes as mixtures, for the orientation off and along the
+    /// normal (`[normal, degenerate]`).
     reflect: [Option<Mixture<ReflectionLobe>>; 2],
     transmit: [Option<Mixture<TransmissionLobe>>; 2],
+}
+
+/// The rough lobes of the primitives of weight > 0 as a mixture, each
+/// picked with probability ∝ `w_k × energy`, `lobe(primitive, (α_u²,
+/// α_v²))` giving `(energy, lobe)`.
+fn mixture<T: crate::DirectionSampler>(
+    parts: &[(f64, &Primitive)],
+    degenerate: bool,
+    lobe: impl Fn(&Primitive, (f64, f64)) -> (f64, T),
+) -> Option<Mixture<T>> {
+    let weighted: Vec<(f64, T)> = parts
+        .iter()
+        .filter(|(w, p)| *w > 0.0 && !p.bsdf.is_pure())
+        .map(|(w, p)| {
+            let (wu, wv) = p.alpha2;
+            let widths = if degenerate {
+                (0.5 * (wu + wv), 0.5 * (wu + wv))
+            } else {
+                (wu, wv)
+            };
+            let (energy, lobe) = lobe(p, widths);
+            (w * energy, lobe)
+        })
+        .collect();
+    Mixture::new(&weighted)
 }
 
 impl Entry {
@@ -227,48 +249,63 @@ impl Entry {
             (*w, Primitive::new(m, local, options))
         });
         let (first_weight, first) = parts.next().expect("a material has a primitive");
-        let mut entry = Entry {
-            first,
-            first_weight,
-            rest: parts.collect(),
-            mixtures: None,
-        };
-        if !entry.rest.is_empty() {
-            let reflect = |degenerate| {
-                entry.mixture(degenerate, |p, (wu, wv)| {
-                    (p.spec.max(MIN_PICK_SPEC), ReflectionLobe { wu, wv })
-                })
-            };
-            let transmit = |degenerate| {
-                entry.mixture(degenerate, |p, (wu, wv)| {
-                    let energy = p.trans * p.tspec;
-                    let pick = if energy > 0.0 {
-                        energy.max(MIN_PICK_SPEC)
-                    } else {
-                        0.0
-                    };
-                    (pick, TransmissionLobe { beta: wu.max(wv) })
-                })
-            };
-            let mixtures = Mixtures {
-                reflect: [reflect(false), reflect(true)],
-                transmit: [transmit(false), transmit(true)],
-            };
-            entry.mixtures = Some(Box::new(mixtures));
+        let rest: Vec<(f64, Primitive)> = parts.collect();
+        if rest.is_empty() {
+            return Entry { first, sum: None };
         }
-        entry
+        let all: Vec<(f64, &Primitive)> = std::iter::once((first_weight, &first))
+            .chain(rest.iter().map(|(w, p)| (*w, p)))
+            .collect();
+        let reflect = |degenerate| {
+            mixture(&all, degenerate, |p, (wu, wv)| {
+                (p.spec.max(MIN_PICK_SPEC), ReflectionLobe { wu, wv })
+            })
+        };
+        let transmit = |degenerate| {
+            mixture(&all, degenerate, |p, (wu, wv)| {
+                let trans = match p.kind {
+                    MaterialKind::Trans => p.bsdf.material().args()[5],
+                    MaterialKind::Trans2 => p.bsdf.material().args()[6],
+                    _ => 0.0,
+                };
+                let energy = trans * p.tspec;
+                let pick = if energy > 0.0 {
+                    energy.max(MIN_PICK_SPEC)
+                } else {
+                    0.0
+                };
+                (pick, TransmissionLobe { beta: wu.max(wv) })
+            })
+        };
+        let (reflect, transmit) = (
+            [reflect(false), reflect(true)],
+            [transmit(false), transmit(true)],
+        );
+        let sum = LobeSum {
+            first_weight,
+            rest,
+            reflect,
+            transmit,
+        };
+        Entry {
+            first,
+            sum: Some(Box::new(sum)),
+        }
     }
 
     /// Every primitive with its weight.
     fn parts(&self) -> impl Iterator<Item = (f64, &Primitive)> {
-        std::iter::once((self.first_weight, &self.first))
-            .chain(self.rest.iter().map(|(w, p)| (*w, p)))
+        let (first_weight, rest) = match &self.sum {
+            Some(sum) => (sum.first_weight, sum.rest.as_slice()),
+            None => (1.0, &[][..]),
+        };
+        std::iter::once((first_weight, &self.first)).chain(rest.iter().map(|(w, p)| (*w, p)))
     }
 
     /// `Σ w_k value(k)`; one primitive's value as it is.
     #[inline]
     fn weighted(&self, value: impl Fn(&Primitive) -> Rgb) -> Rgb {
-        if self.rest.is_empty() {
+        if self.sum.is_none() {
             return value(&self.first);
         }
         let mut sum = [0.0; 3];
@@ -281,37 +318,15 @@ impl Entry {
         sum
     }
 
-    /// The rough lobes of the primitives of weight > 0 as a mixture, each
-    /// picked with probability ∝ `w_k × energy`, `lobe(primitive, (α_u²,
-    /// α_v²))` giving `(energy, lobe)`.
-    fn mixture<T: crate::DirectionSampler>(
-        &self,
-        degenerate: bool,
-        lobe: impl Fn(&Primitive, (f64, f64)) -> (f64, T),
-    ) -> Option<Mixture<T>> {
-        let weighted: Vec<(f64, T)> = self
-            .parts()
-            .filter(|(w, p)| *w > 0.0 && !p.bsdf.is_pure())
-            .map(|(w, p)| {
-                let (wu, wv) = p.alpha2;
-                let widths = if degenerate {
-                    (0.5 * (wu + wv), 0.5 * (wu + wv))
-                } else {
-                    (wu, wv)
-                };
-                let (energy, lobe) = lobe(p, widths);
-                (w * energy, lobe)
-            })
-            .collect();
-        Mixture::new(&weighted)
-    }
-
-    #[inline]
+    /// `f`: the weighted sum (kept out of line, so that the one-primitive
+    /// path of [`Shader::eval`] stays small).
+    #[inline(never)]
     fn eval(&self, l: DVec3, v: DVec3, degenerate: bool) -> Rgb {
         self.weighted(|p| p.bsdf(degenerate).eval(l, v))
     }
 
-    #[inline]
+    /// `f_d`: the weighted sum (out of line, as [`Self::eval`]).
+    #[inline(never)]
     fn diffuse(&self, l: DVec3, v: DVec3) -> Rgb {
         self.weighted(|p| p.diffuse(l, v))
     }
@@ -320,20 +335,27 @@ impl Entry {
         self.parts().any(|(_, p)| p.bsdf.is_pure())
     }
 
+    /// The lobes of the first primitive alone (all of one primitive's).
+    #[inline]
+    fn first_lobes(&self, v: DVec3, degenerate: bool) -> Lobes<'_> {
+        let one = self.first.lobes(v, degenerate);
+        Lobes {
+            reflect: one.reflect.map(LobeMix::One),
+            transmit: one.transmit.map(LobeMix::One),
+            delta: one.delta,
+            diffuse_reflect: one.diffuse_reflect,
+            diffuse_transmit: one.diffuse_transmit,
+        }
+    }
+
     /// The lobes for view `v`: one primitive's own; for several, the
     /// mixtures of their rough lobes when any is on for this view, the
-    /// weighted sum of their deltas, and the diffuse parts of any.
-    #[inline]
+    /// weighted sum of their deltas, and the diffuse parts of any (out of
+    /// line: the tracer's one-primitive path stays small).
+    #[inline(never)]
     fn lobes(&self, v: DVec3, degenerate: bool) -> Lobes<'_> {
-        let Some(mixtures) = &self.mixtures else {
-            let one = self.first.lobes(v, degenerate);
-            return Lobes {
-                reflect: one.reflect.map(LobeMix::One),
-                transmit: one.transmit.map(LobeMix::One),
-                delta: one.delta,
-                diffuse_reflect: one.diffuse_reflect,
-                diffuse_transmit: one.diffuse_transmit,
-            };
+        let Some(mixtures) = &self.sum else {
+            return self.first_lobes(v, degenerate);
         };
         let (mut reflect, mut transmit) = (false, false);
         let mut delta: Option<(Rgb, Rgb)> = None;
@@ -401,6 +423,9 @@ pub struct Shader {
     options: EvalOptions,
     /// Some entry has roughness 0 (mirror and straight-through deltas).
     has_delta: bool,
+    /// Every entry is a lobe sum (else every one is one primitive, shaded
+    /// through its first primitive without looking at the rest).
+    lobe_sum: bool,
     /// A table that follows φ_in: its (θ, φ) grid.
     azimuth: Option<AzimuthGrid>,
 }
@@ -487,6 +512,7 @@ impl Shader {
         let entry = Entry::new(material, orientation, &options);
         Ok(Shader {
             has_delta: entry.is_pure(),
+            lobe_sum: entry.sum.is_some(),
             entries: vec![entry],
             step: None,
             orientation,
@@ -532,6 +558,7 @@ impl Shader {
                     .is_some_and(|g| g.entries.iter().any(Entry::is_pure)),
             entries,
             step: Some(TABLE_STEP_DEG),
+            lobe_sum: table.lobes > 1,
             orientation: reference,
             anisotropic: table.kind.is_anisotropic(),
             transmitting: table.kind.is_transmitting(),
@@ -558,7 +585,7 @@ impl Shader {
 
     /// Primitives per material: 1, or a lobe sum's lobes.
     pub fn lobe_count(&self) -> usize {
-        1 + self.entries[0].rest.len()
+        self.entries[0].parts().count()
     }
 
     /// True if the material (or some θ_in of a table) has roughness 0, so
@@ -572,7 +599,7 @@ impl Shader {
     /// with `degenerate = false` is this BSDF's `eval`.
     pub(crate) fn single_bsdf(&self) -> Option<&Bsdf> {
         let entry = &self.entries[0];
-        (self.step.is_none() && entry.rest.is_empty()).then_some(&entry.first.bsdf)
+        (self.step.is_none() && entry.sum.is_none()).then_some(&entry.first.bsdf)
     }
 
     /// The primitives of a single-material shader with their weights
@@ -628,14 +655,14 @@ impl Shader {
     #[inline]
     pub fn eval(&self, l: DVec3, v: DVec3, degenerate: bool) -> Rgb {
         if let (Some(grid), false) = (&self.azimuth, degenerate) {
-            return grid.mix(l, |e| e.eval(l, v, false));
+            return grid.mix(l, |e| self.entry_eval(e, l, v, false));
         }
         let (i, j, t) = self.blend(l.z);
-        let a = self.entries[i].eval(l, v, degenerate);
+        let a = self.entry_eval(&self.entries[i], l, v, degenerate);
         if t == 0.0 {
             return a;
         }
-        let b = self.entries[j].eval(l, v, degenerate);
+        let b = self.entry_eval(&self.entries[j], l, v, degenerate);
         std::array::from_fn(|k| a[k] + t * (b[k] - a[k]))
     }
 
@@ -644,15 +671,35 @@ impl Shader {
     #[inline]
     pub fn diffuse(&self, l: DVec3, v: DVec3) -> Rgb {
         if let Some(grid) = &self.azimuth {
-            return grid.mix(l, |e| e.diffuse(l, v));
+            return grid.mix(l, |e| self.entry_diffuse(e, l, v));
         }
         let (i, j, t) = self.blend(l.z);
-        let a = self.entries[i].diffuse(l, v);
+        let a = self.entry_diffuse(&self.entries[i], l, v);
         if t == 0.0 {
             return a;
         }
-        let b = self.entries[j].diffuse(l, v);
+        let b = self.entry_diffuse(&self.entries[j], l, v);
         std::array::from_fn(|k| a[k] + t * (b[k] - a[k]))
+    }
+
+    /// `f` of one grid material.
+    #[inline(always)]
+    fn entry_eval(&self, e: &Entry, l: DVec3, v: DVec3, degenerate: bool) -> Rgb {
+        if self.lobe_sum {
+            e.eval(l, v, degenerate)
+        } else {
+            e.first.bsdf(degenerate).eval(l, v)
+        }
+    }
+
+    /// `f_d` of one grid material.
+    #[inline(always)]
+    fn entry_diffuse(&self, e: &Entry, l: DVec3, v: DVec3) -> Rgb {
+        if self.lobe_sum {
+            e.diffuse(l, v)
+        } else {
+            e.first.diffuse(l, v)
+        }
     }
 
     /// The specular part `f − f_d` (clamped at 0 against rounding).
@@ -668,8 +715,11 @@ impl Shader {
     #[inline]
     pub fn lobes(&self, v: DVec3, degenerate: bool) -> Lobes<'_> {
         let (i, j, t) = self.blend(v.z);
-        let e = if t < 0.5 { i } else { j };
-        self.entries[e].lobes(v, degenerate)
+        let e = &self.entries[if t < 0.5 { i } else { j }];
+        match self.lobe_sum {
+            true => e.lobes(v, degenerate),
+            false => e.first_lobes(v, degenerate),
+        }
     }
 }
 
