@@ -31,7 +31,7 @@ pub(crate) struct SynthArgs {
     /// Incident azimuth φ_in in degrees.
     #[arg(long, default_value_t = 0.0)]
     pub phi_in: f64,
-    /// Output format: mpc or mountain.
+    /// Output format.
     #[arg(long, value_parser = words::<SourceFormat>(), default_value_t = SourceFormat::Mpc)]
     pub format: SourceFormat,
     /// Values per row: 1 (CIE-Y, the luminance) or 3 (CIE X, Y, Z; Mountain only).
@@ -98,12 +98,7 @@ pub(crate) fn run(args: SynthArgs) -> Result<()> {
                 source_omega: 0.0,
                 curved: false,
             };
-            let bsdf = material.bsdf()?;
-            // One primitive as itself; a lobe sum as the sum of its lobes.
-            match bsdf.parts() {
-                [(_, one)] => GroundTruth::Model(*one),
-                _ => GroundTruth::Lobes(bsdf),
-            }
+            GroundTruth::material(material.bsdf()?)
         }
         (None, Some(f0)) => {
             GroundTruth::ggx(f0, args.ggx_alpha, &args.ggx_diffuse).map_err(anyhow::Error::msg)?

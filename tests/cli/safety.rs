@@ -665,7 +665,7 @@ fn usage_errors_exit_1_and_help_exits_0_listing_the_models() {
     assert_eq!(o.status.code(), Some(0));
     let help = text(&o.stdout);
     assert!(
-        help.contains("[possible values: plastic, metal, trans, plastic2, metal2, trans2]"),
+        help.contains("[possible values: plastic, metal, trans, plastic2, metal2, trans2, auto]"),
         "{help}"
     );
     assert!(help.contains("--force"), "{help}");

@@ -364,7 +364,8 @@ fn fit_many(
     {
         let again = final_solve(u);
         evaluations += again.evaluations;
-        if again.cost <= solved.cost * (1.0 + 1e-9) {
+        // Costs at rounding level (noise-free data) count as equal.
+        if again.cost <= solved.cost * (1.0 + 1e-9) + 1e-20 {
             solved = again;
         }
     }

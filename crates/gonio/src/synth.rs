@@ -40,6 +40,15 @@ pub enum GroundTruth {
 }
 
 impl GroundTruth {
+    /// A material file's ground truth: one primitive as itself, a lobe sum
+    /// as the weighted sum of its lobes.
+    pub fn material(bsdf: CompositeBsdf) -> GroundTruth {
+        match bsdf.parts() {
+            [(_, one)] => GroundTruth::Model(*one),
+            _ => GroundTruth::Lobes(bsdf),
+        }
+    }
+
     /// The GGX ground truth of `--ggx R,G,B --ggx-alpha A --ggx-diffuse R,G,B`,
     /// checked: three numbers each, 0 < α ≤ 1.
     pub fn ggx(f0: &[f64], alpha: f64, diffuse: &[f64]) -> Result<GroundTruth, String> {

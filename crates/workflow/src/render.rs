@@ -252,6 +252,31 @@ pub struct ImageRequest {
     pub radiance: bool,
 }
 
+impl ImageRequest {
+    /// Checks these options and the scene's, before any work (a front end
+    /// calls it before loading the material).
+    pub fn validate(&self, spec: &SceneSpec) -> Result<(), WorkflowError> {
+        spec.validate()?;
+        let samples = f64::from(self.samples);
+        let check = brtf_model::OptionError::check;
+        check(
+            "--samples",
+            samples,
+            (1.0..=65536.0).contains(&samples),
+            "1 to 65536",
+        )?;
+        if let Some(e) = self.exposure {
+            check(
+                "--exposure",
+                e,
+                e.is_finite() && e > 0.0,
+                "a number above 0",
+            )?;
+        }
+        Ok(())
+    }
+}
+
 /// `prefix` + `ext`; a prefix given with one of the outputs' extensions
 /// (`img.hdr`) loses it, so that it does not write `img.hdr.hdr`.
 pub fn with_extension(prefix: &Path, ext: &str) -> PathBuf {
@@ -273,23 +298,7 @@ pub fn render_image(
     prefix: &Path,
     material_file: Option<&Path>,
 ) -> Result<ImageRun, WorkflowError> {
-    spec.validate()?;
-    let samples = f64::from(request.samples);
-    let check = brtf_model::OptionError::check;
-    check(
-        "--samples",
-        samples,
-        (1.0..=65536.0).contains(&samples),
-        "1 to 65536",
-    )?;
-    if let Some(e) = request.exposure {
-        check(
-            "--exposure",
-            e,
-            e.is_finite() && e > 0.0,
-            "a number above 0",
-        )?;
-    }
+    request.validate(spec)?;
     // The static material as Radiance text, for `--radiance`: one
     // primitive, or a lobe sum's primitives and its mixfunc tree.
     let primitive_text = request.radiance.then(|| {

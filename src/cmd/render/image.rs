@@ -144,6 +144,7 @@ pub(crate) fn run(args: ImageArgs) -> Result<()> {
         exposure: args.exposure,
         radiance: args.radiance,
     };
+    request.validate(&spec)?;
     let material = args.sample.load()?;
     let file = args.sample.material.as_deref();
     let run = with_jobs(args.jobs, || {
