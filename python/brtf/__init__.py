@@ -19,7 +19,6 @@ from ._brtf import (
     Material,
     Measurement,
     __version__,
-    fit,
     read,
     read_klems,
 )
@@ -32,6 +31,7 @@ from ._errors import (
     MissingFileError,
     ModelError,
 )
+from ._python import fit
 
 __all__ = [
     "Albedo",

@@ -70,6 +70,9 @@ class Albedo:
     def tau_spike(self) -> FloatArray: ...
 
 class Material:
+    """One Radiance primitive, or a lobe sum: `lobes` primitives of one type
+    mixed with constant weights (a `mixfunc` tree), one diffuse base."""
+
     def __init__(
         self,
         kind: Model,
@@ -81,6 +84,8 @@ class Material:
         *,
         orientation: Optional[Sequence[float]] = None,
         args: Optional[Sequence[float]] = None,
+        lobes: int = 1,
+        oriented: bool = False,
         variant: Variant = "radiance",
         fresnel_k: Optional[FresnelK] = None,
         source_omega: float = 0.0,
@@ -99,11 +104,21 @@ class Material:
     @property
     def kind(self) -> Model: ...
     @property
-    def args(self) -> list[float]: ...
+    def args(self) -> Optional[list[float]]:
+        """The flat arguments (None for a mixture of no lobe-sum shape)."""
     @property
-    def param_names(self) -> list[str]: ...
+    def param_names(self) -> Optional[list[str]]:
+        """`red green blue spec [split1 ..] rough_k.. [orient]`."""
     @property
-    def params(self) -> dict[str, float]: ...
+    def params(self) -> Optional[dict[str, float]]: ...
+    @property
+    def shape(self) -> Optional[str]:
+        """`metal`, `metal ×2 lobes`, `plastic2 (orientation fitted)`."""
+    @property
+    def lobes(self) -> int: ...
+    @property
+    def components(self) -> list[tuple[float, Material]]:
+        """The primitives mixed, (weight, Material), weights summing to 1."""
     @property
     def orientation(self) -> list[float]: ...
     @property
@@ -114,6 +129,8 @@ class Material:
     def fresnel_k(self) -> float: ...
     @property
     def source_omega(self) -> float: ...
+    @property
+    def curved(self) -> bool: ...
     def eval(self, theta_in: ArrayLike, phi_in: ArrayLike, theta_out: ArrayLike, phi_out: ArrayLike) -> FloatArray:
         """BSDF (1/sr, no cosine), broadcast shape + (3,) for RGB."""
     def albedo(self, theta_in: ArrayLike, phi_in: float = 0.0, tolerance: float = 1e-5) -> Albedo: ...
@@ -143,6 +160,9 @@ class IncidenceFit:
     @property
     def rms_rel(self) -> float: ...
     @property
+    def e1(self) -> Optional[float]:
+        """Σ ω |model − data| / Σ ω |data|: the share of the measured light put in the wrong place."""
+    @property
     def n_points(self) -> int: ...
     @property
     def termination(self) -> str: ...
@@ -169,6 +189,9 @@ class Fit:
     def material(self) -> Optional[Material]: ...
     @property
     def warnings(self) -> list[str]: ...
+    @property
+    def auto(self) -> Optional[dict[str, Any]]:
+        """model="auto": the candidates, `first`, `chosen` and `reason`, as fit.json's `auto`."""
     def table(self, theta_in: ArrayLike) -> dict[str, FloatArray]: ...
     def material_at(self, theta_in: float, phi_in: Optional[float] = None) -> Material: ...
     def to_dict(self) -> dict[str, Any]: ...
@@ -185,9 +208,10 @@ class Fit:
         klems_colour: bool = False,
     ) -> list[str]: ...
 
+# brtf.fit (python/brtf/_python.py) turns its inputs into the paths.
 def fit(
-    inputs: Union[PathLike, Measurement, Sequence[Union[PathLike, Measurement]]],
-    model: Model = "metal",
+    paths: Sequence[PathLike],
+    model: Union[Model, Literal["auto"]] = "metal",
     *,
     gray: bool = False,
     residual: Literal["absolute", "relative", "log"] = "absolute",
@@ -196,7 +220,8 @@ def fit(
     variant: Variant = "radiance",
     fresnel_k: Optional[FresnelK] = None,
     source_omega: float = 0.0,
-    orientation: Sequence[float] = (1.0, 0.0, 0.0),
+    orientation: Optional[Sequence[float]] = None,
+    lobes: int = 1,
     floor: Optional[float] = None,
     colour: Literal["xyz", "as_recorded"] = "xyz",
     weights: Literal["solid_angle", "uniform"] = "solid_angle",

@@ -1,50 +1,23 @@
 //! Rust errors → the Python exception classes of `brtf/_errors.py`, with
-//! the file and line as attributes (`err.file`, `err.line`).
+//! the file and line as attributes (`err.file`, `err.line`): `FormatError`
+//! (a file that is not valid), `MissingFileError`, `FileError` (other
+//! I/O), `ModelError` (a bad model name, argument or option), `FitError`
+//! (a fit that could not be made) and `ExportError` (outputs not written).
 
 use pyo3::prelude::*;
 
-/// Which Python class an error becomes.
-#[derive(Clone, Copy)]
-pub(crate) enum Class {
-    /// A file that is not valid (measurement, `.rad`, `fit.json`).
-    Format,
-    /// A file that does not exist.
-    MissingFile,
-    /// Any other I/O failure.
-    File,
-    /// A bad model name, material argument or option value.
-    Model,
-    /// A fit that could not be made.
-    Fit,
-    /// Exports or plots that could not be written.
-    Export,
-}
-
-impl Class {
-    fn name(self) -> &'static str {
-        match self {
-            Class::Format => "FormatError",
-            Class::MissingFile => "MissingFileError",
-            Class::File => "FileError",
-            Class::Model => "ModelError",
-            Class::Fit => "FitError",
-            Class::Export => "ExportError",
-        }
-    }
-}
-
-/// A `brtf.<Class>` exception with `message`, `file` and `line`.
+/// A `brtf.<class>` exception with `message`, `file` and `line`.
 pub(crate) fn error(
-    class: Class,
-    message: String,
+    class: &str,
+    message: impl Into<String>,
     file: Option<String>,
     line: Option<usize>,
 ) -> PyErr {
     Python::attach(|py| {
         let made = py
             .import("brtf._errors")
-            .and_then(|m| m.getattr(class.name()))
-            .and_then(|c| c.call1((message, file, line)));
+            .and_then(|m| m.getattr(class))
+            .and_then(|c| c.call1((message.into(), file, line)));
         match made {
             Ok(value) => PyErr::from_value(value),
             Err(e) => e,
@@ -54,15 +27,15 @@ pub(crate) fn error(
 
 /// A `brtf.ModelError` (bad argument) with no file.
 pub(crate) fn model(message: impl Into<String>) -> PyErr {
-    error(Class::Model, message.into(), None, None)
+    error("ModelError", message, None, None)
 }
 
 /// The class for an I/O error: missing file or other.
-pub(crate) fn io_class(e: &std::io::Error) -> Class {
+fn io_class(e: &std::io::Error) -> &'static str {
     if e.kind() == std::io::ErrorKind::NotFound {
-        Class::MissingFile
+        "MissingFileError"
     } else {
-        Class::File
+        "FileError"
     }
 }
 
@@ -71,37 +44,29 @@ pub(crate) fn read(e: brtf_gonio::ReadError) -> PyErr {
     let file = Some(e.path().display().to_string());
     match &e {
         brtf_gonio::ReadError::Io { source, .. } => {
-            let message = format!("{e}: {source}");
-            error(io_class(source), message, file, None)
+            error(io_class(source), format!("{e}: {source}"), file, None)
         }
-        _ => {
-            let line = e.line();
-            error(Class::Format, e.to_string(), file, line)
-        }
+        _ => error("FormatError", e.to_string(), file, e.line()),
     }
 }
 
 /// A Radiance text that could not be read.
 pub(crate) fn rad(e: brtf_radiance::RadError) -> PyErr {
     let (file, line) = (Some(e.path.clone()), Some(e.line));
-    error(Class::Format, e.to_string(), file, line)
+    error("FormatError", e.to_string(), file, line)
 }
 
 /// A fit set that could not be made.
-pub(crate) fn fit_set(e: brtf_fit::FitSetError) -> PyErr {
+fn fit_set(e: brtf_fit::FitSetError) -> PyErr {
     use brtf_fit::FitSetError;
     match e {
         FitSetError::Io { path, source } => {
             let message = format!("cannot read {}: {source}", path.display());
-            error(
-                io_class(&source),
-                message,
-                Some(path.display().to_string()),
-                None,
-            )
+            let file = Some(path.display().to_string());
+            error(io_class(&source), message, file, None)
         }
         FitSetError::Read(e) => read(e),
-        other => error(Class::Fit, other.to_string(), None, None),
+        other => error("FitError", other.to_string(), None, None),
     }
 }
 
@@ -112,22 +77,17 @@ pub(crate) fn read_fit(e: brtf_fit::ReadFitError, path: &std::path::Path) -> PyE
     match &e {
         brtf_fit::ReadFitError::Io { error: io, .. } => error(io_class(io), message, file, None),
         brtf_fit::ReadFitError::Parse { error: json, .. } => {
-            error(Class::Format, message, file, Some(json.line()))
+            error("FormatError", message, file, Some(json.line()))
         }
-        _ => error(Class::Format, message, file, None),
+        _ => error("FormatError", message, file, None),
     }
-}
-
-/// Writing outputs failed.
-pub(crate) fn export(message: String) -> PyErr {
-    error(Class::Export, message, None, None)
 }
 
 /// A fit, export or folder step that failed.
 pub(crate) fn workflow(e: brtf_workflow::WorkflowError) -> PyErr {
     use brtf_workflow::WorkflowError;
     match e {
-        WorkflowError::Usage(message) => error(Class::Fit, message, None, None),
+        WorkflowError::Usage(message) => error("FitError", message, None, None),
         WorkflowError::Option(e) => model(e.to_string()),
         WorkflowError::Io(e) => {
             let file = Some(e.path.display().to_string());
@@ -139,6 +99,6 @@ pub(crate) fn workflow(e: brtf_workflow::WorkflowError) -> PyErr {
             let path = e.path().to_path_buf();
             read_fit(e, &path)
         }
-        other => export(other.to_string()),
+        other => error("ExportError", other.to_string(), None, None),
     }
 }

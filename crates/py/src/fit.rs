@@ -1,107 +1,17 @@
 //! `brtf.fit` and `brtf.Fit`: `brtf fit` from Python, on the same
-//! library calls (`brtf_fit::fit_set`, `FitResult::write`,
-//! `brtf_radiance::export::write_exports`, `brtf_plot::write_plots`).
+//! brtf-workflow calls as the command line (`FitJob`, `save_fit`,
+//! `export_into`).
 
-use crate::errors::{self, Class};
+use crate::errors;
 use crate::material::{Material, word};
-use crate::measurement::Measurement;
-use brtf_fit::{FitReport, FitResult, NoProgress};
-use brtf_gonio::klems::{BasisSize, Sides};
+use brtf_fit::{FitReport, FitResult};
+use brtf_gonio::klems::BasisSize;
 use brtf_radiance::export::klems::KlemsOptions;
-use brtf_workflow::{FitInputs, FitJob, FitSettings, Outputs, WorkflowError};
+use brtf_workflow::{Outputs, WorkflowError};
 use numpy::{IntoPyArray, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
-
-/// One file path per input: a path, or a Measurement read from a file.
-fn input_paths(inputs: &Bound<'_, PyAny>) -> PyResult<Vec<PathBuf>> {
-    let one = |item: &Bound<'_, PyAny>| -> PyResult<PathBuf> {
-        if let Ok(m) = item.cast::<Measurement>() {
-            let m = m.get();
-            return m.path.clone().ok_or_else(|| {
-                errors::error(
-                    Class::Fit,
-                    format!(
-                        "{}: brtf.fit fits measurement files; this Measurement has no file of its own (a Klems patch)",
-                        m.origin
-                    ),
-                    None,
-                    None,
-                )
-            });
-        }
-        item.extract::<PathBuf>().map_err(|_| {
-            errors::model(format!(
-                "fit: expected paths or brtf.Measurement objects, found {}",
-                item.get_type()
-                    .name()
-                    .map(|n| n.to_string())
-                    .unwrap_or_default()
-            ))
-        })
-    };
-    let is_single = inputs.is_instance_of::<pyo3::types::PyString>()
-        || inputs.cast::<Measurement>().is_ok()
-        || inputs
-            .is_instance(&inputs.py().import("os")?.getattr("PathLike")?)
-            .unwrap_or(false);
-    if is_single {
-        return Ok(vec![one(inputs)?]);
-    }
-    let mut paths = Vec::new();
-    for item in inputs.try_iter()? {
-        paths.push(one(&item?)?);
-    }
-    if paths.is_empty() {
-        return Err(errors::error(
-            Class::Fit,
-            "no measurement files given".into(),
-            None,
-            None,
-        ));
-    }
-    Ok(paths)
-}
-
-/// Runs the fit: reads every file and fits it, on `jobs` threads (all
-/// cores by default) with the GIL released. A Klems BSDF XML file is fitted
-/// one side at a time (`settings.sides` front or back).
-pub(crate) fn run_fit(
-    py: Python<'_>,
-    inputs: &Bound<'_, PyAny>,
-    settings: FitSettings,
-    name: Option<String>,
-    jobs: Option<usize>,
-) -> PyResult<Fit> {
-    let paths = input_paths(inputs)?;
-    let inputs = FitInputs::classify(&paths).map_err(errors::workflow)?;
-    let side = match (inputs.is_klems(), settings.sides) {
-        (false, Sides::Both) => None,
-        (false, _) => {
-            return Err(errors::model(
-                "side= chooses the side of a Klems BSDF XML file",
-            ));
-        }
-        (true, Sides::Both) => {
-            return Err(errors::model(
-                "a Klems BSDF XML file is fitted one side at a time: side=\"front\" or \"back\"",
-            ));
-        }
-        (true, sides) => sides.sides().first().copied(),
-    };
-    let command_line = vec!["brtf.fit (Python)".to_string()];
-    let fitted = py.detach(|| -> Result<_, WorkflowError> {
-        let job = FitJob::new(&inputs, &settings, name, command_line)?;
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(jobs.unwrap_or(0))
-            .build()
-            .map_err(|e| WorkflowError::Usage(format!("cannot start worker threads: {e}")))?;
-        pool.install(|| job.fit(side, &NoProgress))
-    });
-    let result = fitted.map_err(errors::workflow)?.result;
-    Ok(Fit { result, paths })
-}
 
 /// One fit report (an incidence, or all of them at once).
 #[pyclass(module = "brtf", frozen)]
@@ -115,7 +25,7 @@ pub struct IncidenceFit {
     /// The file (or `all incidences`).
     #[pyo3(get)]
     source: String,
-    /// The material's real arguments (Radiance order).
+    /// The material's real arguments (the flat arguments of a lobe sum).
     #[pyo3(get)]
     material_args: Vec<f64>,
     /// The free scale (1 for absolute data).
@@ -127,54 +37,50 @@ pub struct IncidenceFit {
     /// RMS relative residual.
     #[pyo3(get)]
     rms_rel: f64,
+    /// E1: Σ ω |model − data| ÷ Σ ω |data| over the fitted samples, the
+    /// share of the measured light the material puts in the wrong place.
+    #[pyo3(get)]
+    e1: Option<f64>,
     /// Samples fitted.
     #[pyo3(get)]
     n_points: usize,
     /// Why the optimiser stopped.
     #[pyo3(get)]
-    termination: String,
+    termination: &'static str,
     /// Did the optimiser converge?
     #[pyo3(get)]
     converged: bool,
     /// The warnings, as text.
     #[pyo3(get)]
     warnings: Vec<String>,
+    /// The fitted material (any shape), with the fit's evaluation options.
+    #[pyo3(get)]
+    material: Option<Py<Material>>,
     report: FitReport,
-    material: Option<brtf_model::Material>,
-    options: brtf_model::EvalOptions,
 }
 
 impl IncidenceFit {
-    fn new(result: &FitResult, report: &FitReport) -> IncidenceFit {
-        IncidenceFit {
-            theta_in: report.theta_in,
-            phi_in: report.phi_in,
-            source: report.source.clone(),
-            material_args: report.material_args.clone(),
-            scale: report.scale,
-            cost: report.cost,
-            rms_rel: report.rms_rel,
-            n_points: report.n_points,
-            termination: report.termination.label().to_string(),
-            converged: report.termination.converged(),
-            warnings: report.warnings.iter().map(|w| w.to_string()).collect(),
-            material: result.material_of(report),
-            options: result.options(),
-            report: report.clone(),
-        }
-    }
-
-    /// `name → f(parameter)` over the fitted parameters.
-    fn by_name<'py, T: IntoPyObject<'py>>(
-        &self,
-        py: Python<'py>,
-        f: impl Fn(&brtf_fit::ParamEstimate) -> T,
-    ) -> PyResult<Bound<'py, PyDict>> {
-        let d = PyDict::new(py);
-        for p in &self.report.params {
-            d.set_item(&p.name, f(p))?;
-        }
-        Ok(d)
+    fn new(py: Python<'_>, result: &FitResult, r: &FitReport) -> PyResult<IncidenceFit> {
+        let material = result.composite_of(r).map(|m| {
+            let material = Material::new(m, &result.options(), None);
+            Py::new(py, material)
+        });
+        Ok(IncidenceFit {
+            theta_in: r.theta_in,
+            phi_in: r.phi_in,
+            source: r.source.clone(),
+            material_args: r.material_args.clone(),
+            scale: r.scale,
+            cost: r.cost,
+            rms_rel: r.rms_rel,
+            e1: r.e1,
+            n_points: r.n_points,
+            termination: r.termination.label(),
+            converged: r.termination.converged(),
+            warnings: r.warnings.iter().map(|w| w.to_string()).collect(),
+            material: material.transpose()?,
+            report: r.clone(),
+        })
     }
 }
 
@@ -186,58 +92,9 @@ fn to_python<'py, T: serde::Serialize>(py: Python<'py>, value: &T) -> PyResult<B
 
 #[pymethods]
 impl IncidenceFit {
-    /// The fitted parameters, name → value (physical units).
-    #[getter]
-    fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        self.by_name(py, |p| p.value)
-    }
-
-    /// Standard errors, name → value (None where not available).
-    #[getter]
-    fn stderr<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        self.by_name(py, |p| p.stderr)
-    }
-
-    /// Robust (sandwich) standard errors, name → value.
-    #[getter]
-    fn stderr_robust<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        self.by_name(py, |p| p.stderr_robust)
-    }
-
-    /// The fitted material, with the fit's evaluation options.
-    #[getter]
-    fn material(&self) -> Option<Material> {
-        self.material
-            .map(|m| Material::from_model(m, &self.options, None))
-    }
-
-    /// The adequacy diagnostics (energy, peak, residual-kind check) as a
-    /// dict, as in `fit.json`; None when not computed.
-    #[getter]
-    fn adequacy<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        to_python(py, &self.report.adequacy)
-    }
-
     /// Everything, as this report's entry in `fit.json`.
     fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         to_python(py, &self.report)
-    }
-
-    fn __repr__(&self) -> String {
-        let params: Vec<String> = self
-            .report
-            .params
-            .iter()
-            .map(|p| format!("{}={:.6}", p.name, p.value))
-            .collect();
-        format!(
-            "IncidenceFit(theta_in={}, {}, cost={:.6e}, rms_rel={:.4}, {})",
-            self.theta_in,
-            params.join(", "),
-            self.cost,
-            self.rms_rel,
-            self.termination
-        )
     }
 }
 
@@ -249,6 +106,25 @@ pub struct Fit {
     paths: Vec<PathBuf>,
 }
 
+impl Fit {
+    pub(crate) fn new(result: FitResult, paths: Vec<PathBuf>) -> Fit {
+        Fit { result, paths }
+    }
+
+    /// The θ_in table, or the error of a fit without one.
+    fn table_of(&self) -> PyResult<&brtf_fit::ParamTable> {
+        let message = "this fit has no θ_in table (it needs two incidences or more)";
+        let error = || errors::error("FitError", message, None, None);
+        self.result.table.as_ref().ok_or_else(error)
+    }
+
+    /// A material of this fit, with its options and name.
+    fn material_of(&self, composite: brtf_model::Composite) -> Material {
+        let name = Some(self.result.name.clone());
+        Material::new(composite, &self.result.options(), name)
+    }
+}
+
 #[pymethods]
 impl Fit {
     /// Reads a fit folder's `fit.json` (written by `brtf fit` or `Fit.save`).
@@ -258,22 +134,18 @@ impl Fit {
         let result = py
             .detach(|| FitResult::read(&path))
             .map_err(|e| errors::read_fit(e, &path))?;
-        let paths = result
-            .provenance
-            .inputs
-            .iter()
-            .map(|i| PathBuf::from(&i.path))
-            .collect();
+        let inputs = result.provenance.inputs.iter();
+        let paths = inputs.map(|i| PathBuf::from(&i.path)).collect();
         Ok(Fit { result, paths })
     }
 
     /// The material name.
     #[getter]
-    fn name(&self) -> String {
-        self.result.name.clone()
+    fn name(&self) -> &str {
+        &self.result.name
     }
 
-    /// The model fitted.
+    /// The model fitted (the type of every lobe).
     #[getter]
     fn model(&self) -> &'static str {
         self.result.config.kind.name()
@@ -281,35 +153,40 @@ impl Fit {
 
     /// One report per incidence, by θ_in.
     #[getter]
-    fn incidences(&self) -> Vec<IncidenceFit> {
-        self.result
-            .incidences
-            .iter()
-            .map(|r| IncidenceFit::new(&self.result, r))
+    fn incidences(&self, py: Python<'_>) -> PyResult<Vec<IncidenceFit>> {
+        let reports = self.result.incidences.iter();
+        reports
+            .map(|r| IncidenceFit::new(py, &self.result, r))
             .collect()
     }
 
     /// The fit of all incidences at once.
     #[getter]
-    fn global_fit(&self) -> Option<IncidenceFit> {
-        self.result
-            .global
-            .as_ref()
-            .map(|r| IncidenceFit::new(&self.result, r))
+    fn global_fit(&self, py: Python<'_>) -> PyResult<Option<IncidenceFit>> {
+        let global = self.result.global.as_ref();
+        global
+            .map(|r| IncidenceFit::new(py, &self.result, r))
+            .transpose()
     }
 
     /// The static material (the all-incidence fit), as the exports use.
     #[getter]
     fn material(&self) -> Option<Material> {
-        self.result.static_material().map(|m| {
-            Material::from_model(m, &self.result.options(), Some(self.result.name.clone()))
-        })
+        let composite = self.result.static_composite()?;
+        Some(self.material_of(composite))
     }
 
     /// The warnings of the whole set, as text.
     #[getter]
     fn warnings(&self) -> Vec<String> {
         self.result.warnings.iter().map(|w| w.to_string()).collect()
+    }
+
+    /// What `model="auto"` tried and chose, as `fit.json`'s `auto`
+    /// (None for a fit of one model).
+    #[getter]
+    fn auto<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_python(py, &self.result.auto)
     }
 
     /// The parameters interpolated in θ_in (degrees, scalar or array):
@@ -320,23 +197,17 @@ impl Fit {
         py: Python<'py>,
         theta_in: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let table = self.result.table.as_ref().ok_or_else(|| {
-            errors::error(
-                Class::Fit,
-                "this fit has no θ_in table (it needs two incidences or more)".into(),
-                None,
-                None,
-            )
-        })?;
-        let np = py.import("numpy")?;
-        let array = np.call_method1("asarray", (theta_in, "float64"))?;
+        let table = self.table_of()?;
+        let array = py
+            .import("numpy")?
+            .call_method1("asarray", (theta_in, "float64"))?;
         let shape: Vec<usize> = array.getattr("shape")?.extract()?;
         let flat: Vec<f64> = array.call_method0("ravel")?.extract()?;
         let rows: Vec<Vec<f64>> = flat.iter().map(|&t| table.args_at(t).0).collect();
         let d = PyDict::new(py);
-        for (i, name) in table.kind.param_names().iter().enumerate() {
+        for (i, name) in table.shape().param_names().iter().enumerate() {
             let column: Vec<f64> = rows.iter().map(|r| r[i]).collect();
-            d.set_item(*name, column.into_pyarray(py).reshape(shape.clone())?)?;
+            d.set_item(name, column.into_pyarray(py).reshape(shape.clone())?)?;
         }
         Ok(d)
     }
@@ -346,26 +217,18 @@ impl Fit {
     /// that follows φ_in (anisotropic types fitted to Klems XML).
     #[pyo3(signature = (theta_in, phi_in=None))]
     fn material_at(&self, theta_in: f64, phi_in: Option<f64>) -> PyResult<Material> {
-        let table = self.result.table.as_ref().ok_or_else(|| {
-            errors::error(Class::Fit, "this fit has no θ_in table".into(), None, None)
-        })?;
-        let material = match phi_in {
+        let table = self.table_of()?;
+        let composite = match phi_in {
             Some(phi) => self
                 .result
-                .material_at_direction(theta_in, phi, None)
+                .composite_at_direction(theta_in, phi, None)
                 .ok_or_else(|| errors::model(format!("no material at ({theta_in}°, {phi}°)")))?,
             None => {
-                table
-                    .at(theta_in)
-                    .map_err(|e| errors::model(e.to_string()))?
-                    .material
+                let at = table.composite_at(theta_in);
+                at.map_err(|e| errors::model(e.to_string()))?.0
             }
         };
-        Ok(Material::from_model(
-            material,
-            &self.result.options(),
-            Some(self.result.name.clone()),
-        ))
+        Ok(self.material_of(composite))
     }
 
     /// `fit.json` as a dict.
@@ -448,22 +311,5 @@ impl Fit {
         });
         let files = written.map_err(errors::workflow)?;
         Ok(files.iter().map(|f| f.display().to_string()).collect())
-    }
-
-    fn __repr__(&self) -> String {
-        let global = self.result.global.as_ref().map(|g| {
-            g.params
-                .iter()
-                .map(|p| format!("{}={:.6}", p.name, p.value))
-                .collect::<Vec<_>>()
-                .join(", ")
-        });
-        format!(
-            "Fit(name={:?}, model={:?}, incidences={}, global_fit=({}))",
-            self.result.name,
-            self.result.config.kind.name(),
-            self.result.incidences.len(),
-            global.unwrap_or_default()
-        )
     }
 }

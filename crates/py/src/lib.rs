@@ -1,6 +1,8 @@
 //! `brtf._brtf`: the native module of the Python package `brtf`
 //! (`python/brtf`). It only converts between Python/numpy and the brtf
 //! crates: the logic is theirs. Angles are degrees, as on the command line.
+//! `python/brtf/_python.py` adds what is plain Python: `brtf.fit`'s inputs,
+//! `Material.from_rad`'s file, dicts from `to_dict()`, every `repr`.
 // pyo3's macros expand to `unsafe` blocks; this crate writes none itself.
 #![allow(unsafe_code)]
 
@@ -9,13 +11,17 @@ mod fit;
 mod material;
 mod measurement;
 
+use brtf_fit::NoProgress;
+use brtf_gonio::klems::{Side, Sides};
+use brtf_workflow::{FitInputs, FitJob, WorkflowError};
 use pyo3::prelude::*;
 
-/// Fits a Radiance model to measurement files, as `brtf fit` does: one
-/// fit per incidence, one for all, and the θ_in table. `inputs`: a path,
-/// a `Measurement` read from a file, or a list of these.
+/// Fits a Radiance model to the measurement files `paths`, as `brtf fit`
+/// does: one fit per incidence, one for all, and the θ_in table (`brtf.fit`
+/// turns its `inputs` into the paths). A Klems BSDF XML file is fitted one
+/// side at a time.
 #[pyfunction(name = "fit")]
-#[pyo3(signature = (inputs, model = "metal", *, gray = false, residual = "absolute", loss = "none",
+#[pyo3(signature = (paths, model = "metal", *, gray = false, residual = "absolute", loss = "none",
     name = None, variant = "radiance", fresnel_k = None, source_omega = 0.0,
     orientation = None, lobes = 1, floor = None, colour = "xyz", weights = "solid_angle",
     multistart = true, theta_cap = brtf_gonio::DEFAULT_THETA_CAP_DEG, beam_mask = 3.0,
@@ -25,7 +31,7 @@ use pyo3::prelude::*;
 #[allow(clippy::too_many_arguments)]
 fn fit_set(
     py: Python<'_>,
-    inputs: &Bound<'_, PyAny>,
+    paths: Vec<std::path::PathBuf>,
     model: &str,
     gray: bool,
     residual: &str,
@@ -56,15 +62,9 @@ fn fit_set(
     jobs: Option<usize>,
 ) -> PyResult<fit::Fit> {
     use material::word;
-    let fresnel_k = match fresnel_k {
-        Some(k) => material::parse_fresnel_k(k)?,
-        None => brtf_model::FRESNEL_K_CLASSIC,
-    };
-    if orientation.is_some_and(|o| o.iter().all(|c| *c == 0.0)) {
-        return Err(errors::model(
-            "orientation needs three numbers x, y, z, not all zero",
-        ));
-    }
+    let fresnel_k =
+        fresnel_k.map_or(Ok(brtf_model::FRESNEL_K_CLASSIC), material::parse_fresnel_k)?;
+    let side = side.map(|s| word::<Side>("side", &s)).transpose()?;
     let settings = brtf_workflow::FitSettings {
         gray,
         variant: word("variant", variant)?,
@@ -90,10 +90,7 @@ fn fit_set(
         free_scale,
         interpolation: word("interpolation", interpolation)?,
         adequacy,
-        sides: match side {
-            Some(side) => word::<brtf_gonio::klems::Side>("side", &side)?.into(),
-            None => brtf_gonio::klems::Sides::Both,
-        },
+        sides: side.map_or(Sides::Both, Sides::from),
         incidences: incidences
             .map(|f| {
                 f.parse::<brtf_fit::klems::IncidenceFilter>()
@@ -103,7 +100,29 @@ fn fit_set(
         patch_samples,
         ..brtf_workflow::FitSettings::new(word::<brtf_fit::ModelChoice>("model", model)?)
     };
-    fit::run_fit(py, inputs, settings, name, jobs)
+    let inputs = FitInputs::classify(&paths).map_err(errors::workflow)?;
+    if inputs.is_klems() != side.is_some() {
+        return Err(errors::model(match side {
+            Some(_) => "side= chooses the side of a Klems BSDF XML file",
+            None => {
+                "a Klems BSDF XML file is fitted one side at a time: side=\"front\" or \"back\""
+            }
+        }));
+    }
+    // Every file read and fitted on `jobs` threads (all cores by
+    // default), the GIL released.
+    let command_line = vec!["brtf.fit (Python)".to_string()];
+    let fitted = py.detach(|| -> Result<_, WorkflowError> {
+        let job = FitJob::new(&inputs, &settings, name, command_line)?;
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(jobs.unwrap_or(0))
+            .build();
+        let pool =
+            pool.map_err(|e| WorkflowError::Usage(format!("cannot start worker threads: {e}")))?;
+        pool.install(|| job.fit(side, &NoProgress))
+    });
+    let result = fitted.map_err(errors::workflow)?.result;
+    Ok(fit::Fit::new(result, paths))
 }
 
 #[pymodule]
@@ -117,5 +136,6 @@ fn _brtf(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(measurement::read_klems, m)?)?;
     m.add_function(wrap_pyfunction!(fit_set, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add("_FRESNEL_K_CLASSIC", brtf_model::FRESNEL_K_CLASSIC)?;
     Ok(())
 }

@@ -1,24 +1,61 @@
-//! `brtf.Material`: a Radiance Ward-type material and the options it is
+//! `brtf.Material`: a Radiance Ward-type material, one primitive or a lobe
+//! sum (a constant `mixfunc` tree of them), and the options it is
 //! evaluated with (as `brtf eval`'s `--variant`, `--fresnel-k`,
 //! `--source-omega`, `--curved`).
 
 use crate::errors;
 use brtf_model::{
-    Bsdf, EvalOptions, FRESNEL_K_CLASSIC, Material as Model, MaterialKind, Variant, WordError,
+    Composite, CompositeBsdf, EvalOptions, MaterialKind, Shape, WordError, direction,
 };
 use glam::DVec3;
 use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyTuple};
+use pyo3::types::PyTuple;
 
 /// A Radiance material (`plastic`, `metal`, `trans`, `plastic2`,
-/// `metal2`, `trans2`) with its evaluation options.
+/// `metal2`, `trans2`, or a lobe sum of one of the first four types)
+/// with its evaluation options.
 #[pyclass(module = "brtf", frozen)]
 pub struct Material {
-    pub(crate) model: Model,
-    pub(crate) bsdf: Bsdf,
+    pub(crate) composite: Composite,
+    pub(crate) bsdf: CompositeBsdf,
     /// The material identifier from a `.rad` file (`None` when built here).
-    pub(crate) name: Option<String>,
+    #[pyo3(get)]
+    name: Option<String>,
+    /// The type (of every lobe): `plastic`, `metal`, `trans`, `plastic2`,
+    /// `metal2` or `trans2`.
+    #[pyo3(get)]
+    kind: &'static str,
+    /// The shape: `metal`, `metal ×2 lobes`, `plastic2 (orientation
+    /// fitted)` (None for a mixture of no lobe-sum shape).
+    #[pyo3(get)]
+    shape: Option<String>,
+    /// The number of primitives mixed (1: one primitive).
+    #[pyo3(get)]
+    lobes: usize,
+    /// The formula set: `radiance`, `manual2004` or `ward1992`.
+    #[pyo3(get)]
+    variant: &'static str,
+    /// The roughness-0 Fresnel constant.
+    #[pyo3(get)]
+    fresnel_k: f64,
+    /// The source solid angle in sr (lobe widening as rtrace).
+    #[pyo3(get)]
+    source_omega: f64,
+    /// Evaluated on a curved surface (rtrace's bend of the specular lobe).
+    #[pyo3(get)]
+    curved: bool,
+    /// The arguments: a primitive's real arguments in Radiance order, a
+    /// lobe sum's flat arguments (None for a mixture of no lobe-sum shape).
+    #[pyo3(get)]
+    args: Option<Vec<f64>>,
+    /// The names of `args` (`red`, `green`, `blue`, `spec`, `rough`;
+    /// `split1`, `rough1`, `rough2`, `orient`, ... for lobe sums).
+    #[pyo3(get)]
+    param_names: Option<Vec<String>>,
+    /// The orientation vector of the `*2` types.
+    #[pyo3(get)]
+    orientation: [f64; 3],
 }
 
 /// `fresnel_k`: `"classic"`, `"pyradiance"` or a number.
@@ -40,16 +77,16 @@ pub(crate) fn word<T: std::str::FromStr<Err = WordError>>(what: &str, value: &st
         .map_err(|e| errors::model(format!("{what}={value:?}: {e}")))
 }
 
-/// The evaluation options, checked.
-pub(crate) fn eval_options(
+/// The evaluation options, checked (`fresnel_k` None: the classic constant).
+fn eval_options(
     variant: &str,
-    fresnel_k: &Bound<'_, PyAny>,
+    fresnel_k: Option<&Bound<'_, PyAny>>,
     source_omega: f64,
     curved: bool,
 ) -> PyResult<EvalOptions> {
     let options = EvalOptions {
         variant: word("variant", variant)?,
-        fresnel_k: parse_fresnel_k(fresnel_k)?,
+        fresnel_k: fresnel_k.map_or(Ok(brtf_model::FRESNEL_K_CLASSIC), parse_fresnel_k)?,
         source_omega,
         flat: !curved,
         source_jitter: 0.0,
@@ -60,47 +97,105 @@ pub(crate) fn eval_options(
     Ok(options)
 }
 
-/// A number or three numbers.
-fn rgb_of(value: &Bound<'_, PyAny>) -> PyResult<[f64; 3]> {
+/// A number or `n` numbers.
+fn numbers<const N: usize>(value: &Bound<'_, PyAny>, what: &str) -> PyResult<[f64; N]> {
     if let Ok(x) = value.extract::<f64>() {
-        return Ok([x; 3]);
+        return Ok([x; N]);
     }
     let v: Vec<f64> = value
         .extract()
-        .map_err(|_| errors::model("rgb: expected a number or three numbers"))?;
-    <[f64; 3]>::try_from(v.as_slice())
-        .map_err(|_| errors::model(format!("rgb: expected three numbers, found {}", v.len())))
+        .map_err(|_| errors::model(format!("{what}: expected a number or {N} numbers")))?;
+    <[f64; N]>::try_from(v.as_slice())
+        .map_err(|_| errors::model(format!("{what}: expected {N} numbers, found {}", v.len())))
 }
 
-/// A float or `(u, v)`.
-fn roughness_of(value: &Bound<'_, PyAny>) -> PyResult<[f64; 2]> {
-    if let Ok(x) = value.extract::<f64>() {
-        return Ok([x; 2]);
+/// The real arguments from `rgb`, `spec`, `roughness`, `trans`, `tspec`.
+fn primitive_args(
+    kind: MaterialKind,
+    rgb: &Bound<'_, PyAny>,
+    spec: f64,
+    roughness: Option<&Bound<'_, PyAny>>,
+    trans: Option<f64>,
+    tspec: Option<f64>,
+) -> PyResult<Vec<f64>> {
+    let [r, g, b] = numbers::<3>(rgb, "rgb")?;
+    let [u, v] = roughness.map_or(Ok([0.0; 2]), |x| numbers::<2>(x, "roughness"))?;
+    if !kind.is_anisotropic() && u != v {
+        return Err(errors::model(format!(
+            "{kind} is isotropic: roughness takes one number"
+        )));
     }
-    let v: Vec<f64> = value
-        .extract()
-        .map_err(|_| errors::model("roughness: expected a number or (u, v)"))?;
-    <[f64; 2]>::try_from(v.as_slice()).map_err(|_| {
-        errors::model(format!(
-            "roughness: expected (u, v), found {} numbers",
-            v.len()
-        ))
-    })
+    let mut args = vec![r, g, b, spec, u];
+    if kind.is_anisotropic() {
+        args.push(v);
+    }
+    if kind.is_transmitting() {
+        let need = |x: Option<f64>, what: &str| {
+            x.ok_or_else(|| errors::model(format!("{kind}: {what}= is needed")))
+        };
+        args.extend([need(trans, "trans")?, need(tspec, "tspec")?]);
+    } else if trans.is_some() || tspec.is_some() {
+        return Err(errors::model(format!(
+            "{kind} does not transmit: trans and tspec are for trans and trans2"
+        )));
+    }
+    Ok(args)
 }
 
 impl Material {
-    pub fn from_model(model: Model, options: &EvalOptions, name: Option<String>) -> Material {
+    pub fn new(composite: Composite, options: &EvalOptions, name: Option<String>) -> Material {
         Material {
-            bsdf: Bsdf::new(&model, options),
-            model,
+            bsdf: CompositeBsdf::new(&composite, options),
+            kind: composite.kind().name(),
+            shape: composite.shape().map(|s| s.label()),
+            lobes: composite.components().len(),
+            variant: options.variant.name(),
+            fresnel_k: options.fresnel_k,
+            source_omega: options.source_omega,
+            curved: !options.flat,
+            args: composite.args().map(<[f64]>::to_vec),
+            param_names: composite.shape().map(|s| s.param_names()),
+            orientation: composite.orientation().to_array(),
+            composite,
             name,
         }
     }
 
-    fn build(kind: MaterialKind, args: &[f64], orientation: Option<[f64; 3]>) -> PyResult<Model> {
-        brtf_model::check_args(kind, args).map_err(|e| errors::model(format!("{kind}: {e}")))?;
-        Model::new(kind, args, orientation.map(DVec3::from_array))
-            .map_err(|e| errors::model(e.to_string()))
+    /// The material of `shape` with flat arguments `args`, each lobe's
+    /// arguments checked as Radiance reads them.
+    fn build(shape: Shape, args: &[f64], orientation: Option<[f64; 3]>) -> PyResult<Composite> {
+        let kind = shape.kind;
+        if shape.is_single() {
+            brtf_model::check_args(kind, args)
+                .map_err(|e| errors::model(format!("{kind}: {e}")))?;
+        }
+        let composite = Composite::new(shape, args, orientation.map(DVec3::from_array))
+            .map_err(|e| errors::model(e.to_string()))?;
+        for (k, (_, m)) in composite.components().iter().enumerate() {
+            brtf_model::check_args(kind, m.args())
+                .map_err(|e| errors::model(format!("{}: lobe {}: {e}", shape.label(), k + 1)))?;
+        }
+        Ok(composite)
+    }
+
+    /// `f` of every row into `out` (3 per row): the incidence `ti`, `pi`
+    /// is one for every row when it has one element.
+    fn eval_rows(&self, ti: &[f64], pi: &[f64], to: &[f64], po: &[f64], out: &mut [f64]) {
+        match (self.bsdf.parts(), ti.len()) {
+            ([(_, one)], 1) => one.eval_degrees_from(ti[0], pi[0], to, po, out),
+            ([(_, one)], _) => one.eval_degrees(ti, pi, to, po, out),
+            _ => {
+                let fixed = direction(ti[0], pi[0]);
+                for (k, rgb) in out.chunks_exact_mut(3).enumerate() {
+                    let l = if ti.len() == 1 {
+                        fixed
+                    } else {
+                        direction(ti[k], pi[k])
+                    };
+                    rgb.copy_from_slice(&self.bsdf.eval(l, direction(to[k], po[k])));
+                }
+            }
+        }
     }
 }
 
@@ -117,15 +212,22 @@ fn flat<'py>(
     Ok(array.readonly())
 }
 
+/// Checks every incidence as `brtf eval` does.
+fn check_incidences(ti: &[f64], pi: &[f64]) -> PyResult<()> {
+    for (&t, &p) in ti.iter().zip(pi) {
+        brtf_model::check_incidence(t, p).map_err(|e| errors::model(e.to_string()))?;
+    }
+    Ok(())
+}
+
 #[pymethods]
 impl Material {
     #[new]
     #[pyo3(signature = (kind, rgb = None, spec = 0.0, roughness = None, trans = None, tspec = None,
-        *, orientation = None, args = None, variant = "radiance", fresnel_k = None,
-        source_omega = 0.0, curved = false))]
+        *, orientation = None, args = None, lobes = 1, oriented = false, variant = "radiance",
+        fresnel_k = None, source_omega = 0.0, curved = false))]
     #[allow(clippy::too_many_arguments)]
     fn py_new(
-        py: Python<'_>,
         kind: &str,
         rgb: Option<&Bound<'_, PyAny>>,
         spec: f64,
@@ -134,173 +236,73 @@ impl Material {
         tspec: Option<f64>,
         orientation: Option<[f64; 3]>,
         args: Option<Vec<f64>>,
+        lobes: usize,
+        oriented: bool,
         variant: &str,
         fresnel_k: Option<&Bound<'_, PyAny>>,
         source_omega: f64,
         curved: bool,
     ) -> PyResult<Material> {
         let kind: MaterialKind = word("kind", kind)?;
-        let classic = "classic".into_pyobject(py)?.into_any();
-        let options = eval_options(variant, fresnel_k.unwrap_or(&classic), source_omega, curved)?;
-        let args = match args {
-            Some(args) => {
-                if rgb.is_some() || roughness.is_some() || trans.is_some() || tspec.is_some() {
-                    return Err(errors::model(
-                        "give either args=[...] or rgb/spec/roughness/trans/tspec, not both",
-                    ));
-                }
-                args
+        let shape = Shape::new(kind, lobes, oriented).map_err(errors::model)?;
+        let options = eval_options(variant, fresnel_k, source_omega, curved)?;
+        let args = match (args, rgb) {
+            (Some(_), _)
+                if rgb.is_some() || roughness.is_some() || trans.is_some() || tspec.is_some() =>
+            {
+                return Err(errors::model(
+                    "give either args=[...] or rgb/spec/roughness/trans/tspec, not both",
+                ));
             }
-            None => {
-                let rgb = rgb.ok_or_else(|| errors::model(format!("{kind}: rgb= is needed")))?;
-                let [r, g, b] = rgb_of(rgb)?;
-                let [u, v] = match roughness {
-                    Some(x) => roughness_of(x)?,
-                    None => [0.0; 2],
-                };
-                if !kind.is_anisotropic() && u != v {
-                    return Err(errors::model(format!(
-                        "{kind} is isotropic: roughness takes one number"
-                    )));
-                }
-                let mut args = vec![r, g, b, spec, u];
-                if kind.is_anisotropic() {
-                    args.push(v);
-                }
-                if kind.is_transmitting() {
-                    let need = |x: Option<f64>, what: &str| {
-                        x.ok_or_else(|| errors::model(format!("{kind}: {what}= is needed")))
-                    };
-                    args.push(need(trans, "trans")?);
-                    args.push(need(tspec, "tspec")?);
-                } else if trans.is_some() || tspec.is_some() {
-                    return Err(errors::model(format!(
-                        "{kind} does not transmit: trans and tspec are for trans and trans2"
-                    )));
-                }
-                args
+            (Some(args), _) => args,
+            (None, _) if !shape.is_single() => {
+                return Err(errors::model(format!(
+                    "{}: give its arguments as args=[{}]",
+                    shape.label(),
+                    shape.param_names().join(", ")
+                )));
             }
+            (None, None) => return Err(errors::model(format!("{kind}: rgb= is needed"))),
+            (None, Some(rgb)) => primitive_args(kind, rgb, spec, roughness, trans, tspec)?,
         };
-        let model = Material::build(kind, &args, orientation)?;
-        Ok(Material::from_model(model, &options, None))
+        let composite = Material::build(shape, &args, orientation)?;
+        Ok(Material::new(composite, &options, None))
     }
 
-    /// Reads a material from Radiance text, or from a `.rad` file when
-    /// `text_or_path` is a path (a `pathlib.Path`, or a one-line string
-    /// naming an existing file). `name` picks one of several materials.
+    /// Reads a material (a primitive, or a constant `mixfunc` tree of
+    /// them) from Radiance `text`; `label` names it in messages.
     #[staticmethod]
-    #[pyo3(signature = (text_or_path, name = None, *, variant = "radiance", fresnel_k = None,
+    #[pyo3(signature = (text, label, name = None, variant = "radiance", fresnel_k = None,
         source_omega = 0.0, curved = false))]
-    fn from_rad(
-        py: Python<'_>,
-        text_or_path: &Bound<'_, PyAny>,
+    fn _from_text(
+        text: &str,
+        label: &str,
         name: Option<&str>,
         variant: &str,
         fresnel_k: Option<&Bound<'_, PyAny>>,
         source_omega: f64,
         curved: bool,
     ) -> PyResult<Material> {
-        let classic = "classic".into_pyobject(py)?.into_any();
-        let options = eval_options(variant, fresnel_k.unwrap_or(&classic), source_omega, curved)?;
-        let os = py.import("os")?;
-        let is_path_object = text_or_path.is_instance(&os.getattr("PathLike")?)?;
-        let (text, label) = match text_or_path.extract::<String>() {
-            Ok(text)
-                if !is_path_object
-                    && (text.contains('\n') || !std::path::Path::new(&text).is_file()) =>
-            {
-                if !text.contains('\n') && text.trim_end().ends_with(".rad") {
-                    return Err(errors::error(
-                        errors::Class::MissingFile,
-                        format!("{text}: no such file"),
-                        Some(text.clone()),
-                        None,
-                    ));
-                }
-                (text, "<text>".to_string())
-            }
-            _ => {
-                let path: std::path::PathBuf = text_or_path.extract()?;
-                let label = path.display().to_string();
-                let text = std::fs::read_to_string(&path).map_err(|e| {
-                    errors::error(
-                        errors::io_class(&e),
-                        format!("{label}: cannot read: {e}"),
-                        Some(label.clone()),
-                        None,
-                    )
-                })?;
-                (text, label)
-            }
-        };
-        let primitives = brtf_radiance::parse_primitives(&text, &label).map_err(errors::rad)?;
-        let (chosen, model) =
-            brtf_radiance::select_material(&primitives, name, &label).map_err(errors::rad)?;
-        Ok(Material::from_model(model, &options, Some(chosen)))
+        let options = eval_options(variant, fresnel_k, source_omega, curved)?;
+        let primitives = brtf_radiance::parse_primitives(text, label).map_err(errors::rad)?;
+        let (chosen, composite) =
+            brtf_radiance::select_composite(&primitives, name, label).map_err(errors::rad)?;
+        Ok(Material::new(composite, &options, Some(chosen)))
     }
 
-    /// The type: `plastic`, `metal`, `trans`, `plastic2`, `metal2` or `trans2`.
+    /// The primitives mixed, as `(weight, Material)`, weights summing to 1.
     #[getter]
-    fn kind(&self) -> &'static str {
-        self.model.kind().name()
-    }
-
-    /// The real arguments in Radiance order.
-    #[getter]
-    fn args(&self) -> Vec<f64> {
-        self.model.args().to_vec()
-    }
-
-    /// The names of the real arguments (`red`, `green`, `blue`, `spec`, `rough`, ...).
-    #[getter]
-    fn param_names(&self) -> Vec<&'static str> {
-        self.model.kind().param_names().to_vec()
-    }
-
-    /// The arguments as a dict, name → value.
-    #[getter]
-    fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let d = PyDict::new(py);
-        for (k, v) in self
-            .model
-            .kind()
-            .param_names()
-            .iter()
-            .zip(self.model.args())
-        {
-            d.set_item(*k, *v)?;
-        }
-        Ok(d)
-    }
-
-    /// The orientation vector of the `*2` types.
-    #[getter]
-    fn orientation(&self) -> [f64; 3] {
-        self.model.orientation().to_array()
-    }
-
-    /// The identifier read from a `.rad` file, if any.
-    #[getter]
-    fn name(&self) -> Option<String> {
-        self.name.clone()
-    }
-
-    /// The formula set: `radiance`, `manual2004` or `ward1992`.
-    #[getter]
-    fn variant(&self) -> &'static str {
-        self.bsdf.options().variant.name()
-    }
-
-    /// The roughness-0 Fresnel constant.
-    #[getter]
-    fn fresnel_k(&self) -> f64 {
-        self.bsdf.options().fresnel_k
-    }
-
-    /// The source solid angle in sr (lobe widening as rtrace).
-    #[getter]
-    fn source_omega(&self) -> f64 {
-        self.bsdf.options().source_omega
+    fn components(&self) -> Vec<(f64, Material)> {
+        let options = self.bsdf.options();
+        let parts = self.composite.components().iter();
+        parts
+            .map(|(w, m)| {
+                (
+                    *w,
+                    Material::new(Composite::from_material(m), options, None),
+                )
+            })
+            .collect()
     }
 
     /// The BSDF in 1/sr (no cosine), RGB, for light from (θ_in, φ_in)
@@ -321,29 +323,25 @@ impl Material {
             .collect::<PyResult<Vec<_>>>()?;
         let shape = np.call_method1("broadcast_shapes", PyTuple::new(py, &shapes)?)?;
         let incidence_shape = np.call_method1("broadcast_shapes", (&shapes[0], &shapes[1]))?;
-        let one_incidence = incidence_shape.len()? == 0
-            || np
-                .call_method1("prod", (&incidence_shape,))?
-                .extract::<usize>()?
-                == 1;
-        let to = flat(&np, theta_out, &shape)?;
-        let po = flat(&np, phi_out, &shape)?;
-        let (to, po) = (to.as_slice()?, po.as_slice()?);
-        let mut out = vec![0.0; 3 * to.len()];
-        if one_incidence {
-            let ti = flat(&np, theta_in, &incidence_shape)?;
-            let pi = flat(&np, phi_in, &incidence_shape)?;
-            let (ti, pi) = (ti.as_slice()?[0], pi.as_slice()?[0]);
-            brtf_model::check_incidence(ti, pi).map_err(|e| errors::model(e.to_string()))?;
-            py.detach(|| self.bsdf.eval_degrees_from(ti, pi, to, po, &mut out));
+        let size = np.call_method1("prod", (&incidence_shape,))?;
+        // One incidence for every row, or one per row.
+        let rows = if size.extract::<f64>()? == 1.0 {
+            incidence_shape
         } else {
-            let ti = flat(&np, theta_in, &shape)?;
-            let pi = flat(&np, phi_in, &shape)?;
-            let (ti, pi) = (ti.as_slice()?, pi.as_slice()?);
-            for (&t, &p) in ti.iter().zip(pi) {
-                brtf_model::check_incidence(t, p).map_err(|e| errors::model(e.to_string()))?;
-            }
-            py.detach(|| self.bsdf.eval_degrees(ti, pi, to, po, &mut out));
+            shape.clone()
+        };
+        let (ti, pi) = (flat(&np, theta_in, &rows)?, flat(&np, phi_in, &rows)?);
+        let (to, po) = (flat(&np, theta_out, &shape)?, flat(&np, phi_out, &shape)?);
+        let (ti, pi, to, po) = (
+            ti.as_slice()?,
+            pi.as_slice()?,
+            to.as_slice()?,
+            po.as_slice()?,
+        );
+        check_incidences(ti, pi)?;
+        let mut out = vec![0.0; 3 * to.len()];
+        if !to.is_empty() {
+            py.detach(|| self.eval_rows(ti, pi, to, po, &mut out));
         }
         let mut full_shape: Vec<usize> = shape.extract()?;
         full_shape.push(3);
@@ -369,16 +367,11 @@ impl Material {
         let shape = np.call_method1("shape", (theta_in,))?;
         let thetas = flat(&np, theta_in, &shape)?;
         let thetas = thetas.as_slice()?.to_vec();
-        for &t in &thetas {
-            brtf_model::check_incidence(t, phi_in).map_err(|e| errors::model(e.to_string()))?;
-        }
+        check_incidences(&thetas, &vec![phi_in; thetas.len()])?;
         let results: Vec<brtf_model::Albedo> = py.detach(|| {
-            thetas
-                .iter()
-                .map(|&t| {
-                    brtf_model::albedo(&self.bsdf, brtf_model::direction(t, phi_in), tolerance)
-                })
-                .collect()
+            let light = |t: f64| direction(t, phi_in);
+            let albedo = |&t: &f64| brtf_model::composite_albedo(&self.bsdf, light(t), tolerance);
+            thetas.iter().map(albedo).collect()
         });
         let mut full_shape: Vec<usize> = shape.extract()?;
         full_shape.push(3);
@@ -397,7 +390,9 @@ impl Material {
         })
     }
 
-    /// The material as a Radiance primitive (`void metal NAME ...`).
+    /// The material as Radiance text: one primitive (`void metal NAME
+    /// ...`), or a lobe sum's primitives `NAME.1` ... and the `mixfunc`
+    /// tree named `NAME` last.
     #[pyo3(signature = (name = None))]
     fn to_rad(&self, name: Option<&str>) -> PyResult<String> {
         let name = name.or(self.name.as_deref()).unwrap_or("material");
@@ -406,8 +401,11 @@ impl Material {
                 "name {name:?}: not a Radiance identifier (letters, digits, _ - . only)"
             )));
         }
-        let primitive = brtf_radiance::primitive_from_material(&self.model, name);
-        Ok(brtf_radiance::format_primitive(&primitive))
+        let primitives = brtf_radiance::composite_primitives(&self.composite, name);
+        Ok(primitives
+            .iter()
+            .map(brtf_radiance::format_primitive)
+            .collect())
     }
 
     /// For `scripts/bench-python.py` only: seconds the Rust loop behind
@@ -425,47 +423,15 @@ impl Material {
         per_row: bool,
     ) -> f64 {
         let n = theta_out.len().min(phi_out.len());
-        let (ti, pi) = (vec![theta_in; n], vec![phi_in; n]);
+        let rows = if per_row { n } else { 1 };
+        let (ti, pi) = (vec![theta_in; rows], vec![phi_in; rows]);
         let mut out = vec![0.0; 3 * n];
         py.detach(|| {
             let start = std::time::Instant::now();
-            if per_row {
-                self.bsdf
-                    .eval_degrees(&ti, &pi, &theta_out, &phi_out, &mut out);
-            } else {
-                self.bsdf
-                    .eval_degrees_from(theta_in, phi_in, &theta_out, &phi_out, &mut out);
-            }
+            self.eval_rows(&ti, &pi, &theta_out[..n], &phi_out[..n], &mut out);
             std::hint::black_box(&out);
             start.elapsed().as_secs_f64()
         })
-    }
-
-    fn __repr__(&self) -> String {
-        let args: Vec<String> = self.model.args().iter().map(|a| a.to_string()).collect();
-        let mut text = format!(
-            "Material({:?}, args=[{}]",
-            self.model.kind().name(),
-            args.join(", ")
-        );
-        if self.model.kind().is_anisotropic() {
-            let o = self.model.orientation();
-            text += &format!(", orientation=({}, {}, {})", o.x, o.y, o.z);
-        }
-        let options = self.bsdf.options();
-        if options.variant != Variant::Radiance {
-            text += &format!(", variant={:?}", options.variant.name());
-        }
-        if options.fresnel_k != FRESNEL_K_CLASSIC {
-            text += &format!(", fresnel_k={}", options.fresnel_k);
-        }
-        if options.source_omega != 0.0 {
-            text += &format!(", source_omega={}", options.source_omega);
-        }
-        if !options.flat {
-            text += ", curved=True";
-        }
-        text + ")"
     }
 }
 
@@ -473,7 +439,7 @@ impl Material {
 /// (last axis RGB): the diffuse and rough parts, and the mirror and
 /// straight-through delta parts of roughness-0 surfaces.
 #[pyclass(module = "brtf", frozen, get_all)]
-pub struct Albedo {
+pub(crate) struct Albedo {
     /// ρ_dh without the delta part.
     pub rho: Py<PyAny>,
     /// τ_dh without the delta part.
@@ -482,15 +448,4 @@ pub struct Albedo {
     pub rho_spike: Py<PyAny>,
     /// Straight-through delta transmittance.
     pub tau_spike: Py<PyAny>,
-}
-
-#[pymethods]
-impl Albedo {
-    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
-        Ok(format!(
-            "Albedo(rho={}, tau={})",
-            self.rho.bind(py).repr()?,
-            self.tau.bind(py).repr()?
-        ))
-    }
 }

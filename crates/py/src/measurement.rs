@@ -13,13 +13,42 @@ use std::path::PathBuf;
 /// One gonio-photometer scan: one incidence, N scattered samples.
 #[pyclass(module = "brtf", frozen)]
 pub struct Measurement {
-    pub(crate) scan: Scan,
-    /// The file it was read from (`None` for Klems patches, which cannot
-    /// be re-read as one measurement).
-    pub(crate) path: Option<PathBuf>,
+    scan: Scan,
+    /// θ_in in degrees (towards the light, from the front normal).
+    #[pyo3(get)]
+    theta_in: f64,
+    /// φ_in in degrees, in [0, 360).
+    #[pyo3(get)]
+    phi_in: f64,
+    /// What the values are: `BSDF`, `DSF` or `raw`.
+    #[pyo3(get)]
+    quantity: &'static str,
+    /// The values' unit: `1/sr`, or the raw signal's (e.g. `uA`).
+    #[pyo3(get)]
+    unit: String,
+    /// The raw signal's beam integral, when the file gives it.
+    #[pyo3(get)]
+    beam_integral: Option<f64>,
+    /// `CIE-Y` (one channel) or `CIE-XYZ` (three).
+    #[pyo3(get)]
+    channels: &'static str,
+    /// The file format, e.g. `pab-opto Mountain`.
+    #[pyo3(get)]
+    format: String,
+    /// `#sample_name`, when the file has one.
+    #[pyo3(get)]
+    sample_name: Option<String>,
+    /// The file read (None for Klems patches, which cannot be re-read as
+    /// one measurement).
+    #[pyo3(get)]
+    path: Option<String>,
     /// A label for messages and `repr`.
-    pub(crate) origin: String,
-    pub(crate) solid_angle: Vec<f64>,
+    #[pyo3(get, name = "_origin")]
+    origin: String,
+    /// The header lines as the file has them.
+    #[pyo3(get)]
+    header_lines: Vec<String>,
+    solid_angle: Vec<f64>,
 }
 
 impl Measurement {
@@ -28,29 +57,30 @@ impl Measurement {
         // The Python side sees the solid angles through `solid_angle`; the
         // samples keep the file's own (or none), as `brtf fit` reads them.
         scan.samples.shrink_to_fit();
+        let beam_integral = match &scan.quantity {
+            brtf_gonio::Quantity::Raw { beam_integral, .. } => *beam_integral,
+            _ => None,
+        };
         Measurement {
-            scan,
-            path,
+            theta_in: scan.incidence.theta_deg,
+            phi_in: scan.incidence.phi_deg,
+            quantity: scan.quantity.name(),
+            unit: scan.quantity.unit().to_string(),
+            beam_integral,
+            channels: scan.channels.colorimetry_name(),
+            format: scan.format.describe().to_string(),
+            sample_name: scan.sample_name.clone(),
+            path: path.map(|p| p.display().to_string()),
             origin,
+            header_lines: scan.header.clone(),
             solid_angle,
+            scan,
         }
     }
 }
 
 #[pymethods]
 impl Measurement {
-    /// θ_in in degrees (towards the light, from the front normal).
-    #[getter]
-    fn theta_in(&self) -> f64 {
-        self.scan.incidence.theta_deg
-    }
-
-    /// φ_in in degrees, in [0, 360).
-    #[getter]
-    fn phi_in(&self) -> f64 {
-        self.scan.incidence.phi_deg
-    }
-
     /// θ_out of every sample, degrees (> 90: back side).
     #[getter]
     fn theta<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
@@ -69,10 +99,8 @@ impl Measurement {
     #[getter]
     fn value<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let channels = self.scan.channels.count();
-        let flat: Vec<f64> = self
-            .scan
-            .samples
-            .iter()
+        let samples = self.scan.samples.iter();
+        let flat: Vec<f64> = samples
             .flat_map(|s| s.values[..channels].iter().copied())
             .collect();
         let array = Array2::from_shape_vec((self.scan.samples.len(), channels), flat)
@@ -87,51 +115,6 @@ impl Measurement {
         self.solid_angle.clone().into_pyarray(py)
     }
 
-    /// What the values are: `BSDF`, `DSF` or `raw`.
-    #[getter]
-    fn quantity(&self) -> &'static str {
-        self.scan.quantity.name()
-    }
-
-    /// The values' unit: `1/sr`, or the raw signal's (e.g. `uA`).
-    #[getter]
-    fn unit(&self) -> String {
-        self.scan.quantity.unit().to_string()
-    }
-
-    /// The raw signal's beam integral, when the file gives it.
-    #[getter]
-    fn beam_integral(&self) -> Option<f64> {
-        match &self.scan.quantity {
-            brtf_gonio::Quantity::Raw { beam_integral, .. } => *beam_integral,
-            _ => None,
-        }
-    }
-
-    /// `CIE-Y` (one channel) or `CIE-XYZ` (three).
-    #[getter]
-    fn channels(&self) -> &'static str {
-        self.scan.channels.colorimetry_name()
-    }
-
-    /// The file format, e.g. `pab-opto Mountain`.
-    #[getter]
-    fn format(&self) -> String {
-        self.scan.format.describe().to_string()
-    }
-
-    /// `#sample_name`, when the file has one.
-    #[getter]
-    fn sample_name(&self) -> Option<String> {
-        self.scan.sample_name.clone()
-    }
-
-    /// The file read (None for Klems patches).
-    #[getter]
-    fn path(&self) -> Option<String> {
-        self.path.as_ref().map(|p| p.display().to_string())
-    }
-
     /// The header as a dict: `#key value` lines give `key → value`
     /// (quotes and tabs trimmed), `.mpc` `#label:` lines followed by a
     /// value line give `label → value`. A key seen twice keeps its last value.
@@ -144,26 +127,8 @@ impl Measurement {
         Ok(dict)
     }
 
-    /// The header lines as the file has them.
-    #[getter]
-    fn header_lines(&self) -> Vec<String> {
-        self.scan.header.clone()
-    }
-
     fn __len__(&self) -> usize {
         self.scan.samples.len()
-    }
-
-    fn __repr__(&self) -> String {
-        format!(
-            "Measurement({:?}, theta_in={}, phi_in={}, samples={}, quantity={:?}, channels={:?})",
-            self.origin,
-            self.scan.incidence.theta_deg,
-            self.scan.incidence.phi_deg,
-            self.scan.samples.len(),
-            self.scan.quantity.name(),
-            self.scan.channels.colorimetry_name()
-        )
     }
 }
 
