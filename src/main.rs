@@ -1,6 +1,5 @@
-//! The `brtf` command line: argument parsing, progress and wiring only.
-//! Physics lives in `brtf-model`, file formats in `brtf-gonio`, Radiance
-//! text in `brtf-radiance`.
+//! The `brtf` command line: argument parsing, progress and printing only;
+//! the work is done by the crates (ARCHITECTURE.md).
 
 /// `eprintln!` that does not panic when standard error cannot be written
 /// (closed, or a full device): the message is dropped, the run goes on.
@@ -45,11 +44,9 @@ enum Command {
     Plot(cmd::plot::PlotArgs),
 }
 
-/// The allocator: mimalloc keeps freed memory for the next phase of a run
-/// and backs it with large pages, where glibc's malloc by default hands
-/// big blocks back to the kernel and faults them in again 4 KiB at a time
-/// (a lean golden_paper fit: 16.9k page faults and ~40% more wall time;
-/// docs/benchmarks.md, "The allocator").
+/// mimalloc keeps freed memory for the next phase of a run, where glibc's
+/// malloc hands big blocks back to the kernel and faults them in again
+/// (docs/benchmarks.md, "The allocator").
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 

@@ -105,6 +105,7 @@ pub(crate) fn run(args: SynthArgs) -> Result<()> {
         }
         _ => bail!("give the ground truth: --material M.rad or --ggx R,G,B"),
     };
+    let command = super::fit::command_line().join(" ");
     let set = SynthSet {
         truth,
         theta_in: args.theta_in.clone(),
@@ -136,10 +137,7 @@ pub(crate) fn run(args: SynthArgs) -> Result<()> {
                 .file_name()
                 .map_or_else(|| "synth".into(), |n| n.to_string_lossy().into_owned())
         }),
-        header: vec![format!(
-            "#command: {}",
-            super::fit::command_line().join(" ")
-        )],
+        header: vec![format!("#command: {command}")],
     };
     let written =
         brtf_workflow::write_synth_set(&set, &args.out, args.material.as_deref(), args.force)?;
