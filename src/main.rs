@@ -44,16 +44,29 @@ enum Command {
     Plot(cmd::plot::PlotArgs),
 }
 
-/// mimalloc keeps freed memory for the next phase of a run, where glibc's
-/// malloc hands big blocks back to the kernel and faults them in again
-/// (docs/benchmarks.md, "The allocator").
+/// mimalloc, keeping freed memory (no purging) on transparent huge pages:
+/// glibc's malloc and mimalloc's defaults fault big blocks in again after
+/// each free, 4 KiB at a time (docs/benchmarks.md, "The allocator").
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
+/// mimalloc v2's `mi_option_purge_delay` (libmimalloc-sys names no constant).
+const MI_OPTION_PURGE_DELAY: libmimalloc_sys::mi_option_t = 15;
+
+#[allow(unsafe_code)]
+fn tune_allocator() {
+    // SAFETY: stores of two options, before any other thread is started.
+    unsafe {
+        libmimalloc_sys::mi_option_set(libmimalloc_sys::mi_option_large_os_pages, 1);
+        libmimalloc_sys::mi_option_set(MI_OPTION_PURGE_DELAY, -1);
+    }
+}
 
 /// Exit codes (docs/outputs.md): 0 on success and when the reader of
 /// standard output has gone (as ripgrep), 1 on every error, the command
 /// line's included; `--help` and `--version` exit 0.
 fn main() {
+    tune_allocator();
     let cli = Cli::try_parse().unwrap_or_else(|e| {
         let _ = e.print();
         std::process::exit(if e.use_stderr() { 1 } else { 0 })

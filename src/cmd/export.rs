@@ -1,7 +1,6 @@
-//! `brtf export DIR`: the Radiance materials of a fit folder (static,
-//! θ_in-dependent with its `.cal`, and a preview scene), from `fit.json`;
-//! with `--klems`, a Klems BSDF XML file instead, from a fit folder or
-//! (`--material`) from a static material.
+//! `brtf export DIR`: a fit folder's Radiance materials (static, θ_in-
+//! dependent with its `.cal`, a preview scene) from `fit.json`; `--klems`:
+//! a Klems BSDF XML file, of a fit folder or (`--material`) a material.
 
 use super::material::FormulaArgs;
 use super::output::print;
@@ -9,10 +8,9 @@ use super::shared::words;
 use anyhow::{Context, Result};
 use brtf_gonio::klems::BasisSize;
 use brtf_radiance::export::ExportOptions;
-use brtf_radiance::export::klems::{KlemsOptions, SolarBand};
-use brtf_workflow::read_material_file;
+use brtf_radiance::export::klems::KlemsOptions;
 use clap::Args;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub(crate) struct ExportArgs {
@@ -106,20 +104,10 @@ fn run_klems(args: &ExportArgs, basis: BasisSize) -> Result<()> {
         args.at.is_none(),
         "--at cannot be used with --klems: each incident patch gets its own θ_in"
     );
-    let solar = match k.solar.as_deref() {
-        None => SolarBand::None,
-        Some("visible") => SolarBand::ReuseVisible,
-        Some(file) => SolarBand::Material {
-            material: read_material_file(Path::new(file), None)
-                .with_context(|| format!("--solar {file}"))?
-                .1,
-            source: file.to_string(),
-        },
-    };
     let mut options = KlemsOptions::new("");
     options.basis = basis.basis();
     options.sampling.samples = k.klems_samples;
-    options.solar = solar;
+    options.solar = brtf_workflow::solar_band(k.solar.as_deref())?;
     options.colour = k.colour;
     options.manufacturer = k.manufacturer.clone();
     options.thickness_mm = k.thickness;

@@ -1,4 +1,4 @@
-//! Issue 14: no run loses or corrupts a result, and no bad option runs.
+//! No run loses or corrupts a result, and no bad option runs.
 //!
 //! * Output folders: `kill -9` at points spread over a whole fit (the old
 //!   or the new folder, whole, each time, and no stray file once the next

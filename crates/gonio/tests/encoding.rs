@@ -1,4 +1,4 @@
-//! Encodings and line ends (issue 14): Latin-1 / Windows-1252 bytes in
+//! Encodings and line ends: Latin-1 / Windows-1252 bytes in
 //! header comments are read, CR-only line ends are read like LF and CRLF,
 //! and line numbers in errors count every kind of line end.
 

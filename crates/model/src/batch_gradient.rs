@@ -538,7 +538,7 @@ impl<
         let zero = ops.splat(0.0);
         // The loads and the loop are written out as in SumOp: a shared
         // driver taking the loop body as a closure was not inlined into
-        // pulp's target-feature function (17× slower, 2026-11-24).
+        // pulp's target-feature function (17× slower).
         let (ci, ci_tail) = S::as_simd_f64s(g.light_cosine);
         let (co, co_tail) = S::as_simd_f64s(g.view_cosine);
         let (lf, lf_tail) = S::as_simd_f64s(g.lobe_factor);

@@ -39,7 +39,7 @@ pub use error::WorkflowError;
 pub use folder::{FolderWritten, Outputs, save_fit, write_fit_folder};
 pub use info::describe_files;
 pub use inputs::{FitInputs, default_name, is_klems, sample_files};
-pub use material::read_material_file;
+pub use material::{read_material_file, solar_band};
 pub use render::{
     GonioRequest, GonioRun, ImageRequest, ImageRun, MaterialSource, RenderMaterial,
     load_render_material, render_gonio, render_image, with_extension, write_synth_set,

@@ -2,6 +2,7 @@
 
 use crate::WorkflowError;
 use brtf_model::Composite;
+use brtf_radiance::export::klems::SolarBand;
 use std::path::Path;
 
 /// Reads the Radiance file `path` and picks the material `name` (or its
@@ -21,4 +22,19 @@ pub fn read_material_file(
     })?;
     let primitives = brtf_radiance::parse_primitives(&text, &shown)?;
     Ok(brtf_radiance::select_composite(&primitives, name, &shown)?)
+}
+
+/// The Solar band of `--solar`: none, `visible` (the Visible values again,
+/// said in the file as an assumption), or the material of a Radiance file.
+pub fn solar_band(arg: Option<&str>) -> Result<SolarBand, WorkflowError> {
+    Ok(match arg {
+        None => SolarBand::None,
+        Some("visible") => SolarBand::ReuseVisible,
+        Some(file) => SolarBand::Material {
+            material: read_material_file(Path::new(file), None)
+                .map_err(|e| WorkflowError::Usage(format!("--solar {file}: {e}")))?
+                .1,
+            source: file.to_string(),
+        },
+    })
 }
