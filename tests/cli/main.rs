@@ -1,12 +1,21 @@
-//! End-to-end tests of the `brtf` binary.
+//! End-to-end tests of the `brtf` binary, one module per area:
 //!
-//! * `eval`, `albedo`: the CLI contract of `brtf eval` and `brtf albedo`
-//!   (columns, stdin handling, material selection, error messages, a few
-//!   exact values).
-//! * `rtrace`: live comparison against real Radiance (`oconv` + `rtrace`).
-//!   It looks for Radiance in `$RADIANCE_BIN`, on `PATH`, then in the repo's
-//!   `.venv` (pyradiance). Without Radiance it warns and skips, except under
-//!   `CI`, where it fails.
+//! * `eval`, `albedo`, `info`: the contracts of those commands;
+//!   `rtrace`: `brtf eval` against live Radiance (`oconv` + `rtrace`), and
+//!   `lobes`: mixfunc lobe sums against it. Radiance is looked for in
+//!   `$RADIANCE_BIN`, on `PATH`, then in the repo's `.venv` (pyradiance);
+//!   without it the live tests warn and skip, except under `CI`.
+//! * `fit`, `recovery`, `many`, `peer`, `speed`: `brtf synth` + `brtf fit`
+//!   (known parameters back, real scans, sample folders, the scipy peer and
+//!   the data of the speed comparison).
+//! * `contract`, `reproduce`, `safety`: what every command reads from a
+//!   fit folder, `fits/alu-ggx` rebuilt byte for byte, and no lost result
+//!   or unchecked option.
+//! * `export`, `klems_export`, `klems_fit`: Radiance and Klems exports, and
+//!   Klems XML in.
+//! * `render`, `lobe_render`, `plot`: the tracer, `brtf check` and the plots.
+//! * `layout`: the source tree's shape (no import circles, thin front ends).
+//! * `common`: shared helpers.
 
 mod albedo;
 mod common;
@@ -17,6 +26,7 @@ mod fit;
 mod info;
 mod klems_export;
 mod klems_fit;
+mod layout;
 mod lobe_render;
 mod lobes;
 mod many;

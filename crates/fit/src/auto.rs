@@ -11,14 +11,13 @@
 //! [`MARGIN_RELATIVE`]) of the best: more parameters must earn their place.
 //! A candidate whose lobes collapsed is not chosen: its simpler twin is.
 
-use crate::config::FitConfig;
+use crate::config::{FitConfig, FitError};
 use crate::data::IncidenceData;
 use crate::diagnose;
 use crate::fitter::{SharedGeometry, e1_parts, heldout_e1_parts, shared_geometry};
 use crate::params::ParamMap;
 use crate::recipe::PreparedMeasurement;
 use crate::report::{FitReport, FitWarning};
-use crate::set::FitSetError;
 use brtf_model::MaterialKind;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -107,7 +106,7 @@ fn judge(
     prepared: &[&PreparedMeasurement],
     data: &[IncidenceData],
     base: Option<&[FitReport]>,
-) -> Result<Candidate, FitSetError> {
+) -> Result<Candidate, FitError> {
     let started = Instant::now();
     let geometry: Vec<SharedGeometry> = shared_geometry(data, &config)?;
     let reports: Vec<FitReport> = data
@@ -179,7 +178,7 @@ pub(crate) fn choose(
     base: &FitConfig,
     prepared: &[&PreparedMeasurement],
     data: &[IncidenceData],
-) -> Result<(FitConfig, AutoChoice, Vec<FitReport>), FitSetError> {
+) -> Result<(FitConfig, AutoChoice, Vec<FitReport>), FitError> {
     // The family: plastic or metal, by the one-lobe fits' cost. Under a
     // free scale the colour is held at 1, where metal is plastic: plastic.
     let one = |kind| FitConfig {
