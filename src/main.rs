@@ -12,7 +12,7 @@ macro_rules! say {
 
 mod cmd;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 /// Fit Radiance materials to gonio-photometer measurements.
 #[derive(Parser, Debug)]
@@ -67,7 +67,16 @@ fn tune_allocator() {
 /// line's included; `--help` and `--version` exit 0.
 fn main() {
     tune_allocator();
-    let cli = Cli::try_parse().unwrap_or_else(|e| {
+    // `--theta-cap -5` is a value, not an unknown option, in every command.
+    fn negative_numbers(c: clap::Command) -> clap::Command {
+        c.allow_negative_numbers(true)
+            .mut_subcommands(negative_numbers)
+    }
+    let command = negative_numbers(Cli::command());
+    let parsed = command
+        .try_get_matches()
+        .and_then(|m| Cli::from_arg_matches(&m));
+    let cli = parsed.unwrap_or_else(|e| {
         let _ = e.print();
         std::process::exit(if e.use_stderr() { 1 } else { 0 })
     });

@@ -1,7 +1,7 @@
 //! Helpers several subcommands share: option words, worker threads and
 //! CSV output.
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use brtf_model::{OptionWords, WordError};
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 
@@ -18,18 +18,9 @@ where
     PossibleValuesParser::new(values.collect::<Vec<_>>()).try_map(|s| s.parse::<T>())
 }
 
-/// Runs `f` on a rayon pool of `jobs` threads (or the global pool).
+/// Runs `f` on `jobs` worker threads (checked), or on all cores.
 pub(crate) fn with_jobs<T: Send>(jobs: Option<usize>, f: impl FnOnce() -> T + Send) -> Result<T> {
-    match jobs {
-        Some(n) => {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(n.max(1))
-                .build()
-                .context("cannot start worker threads")?;
-            Ok(pool.install(f))
-        }
-        None => Ok(f()),
-    }
+    Ok(brtf_workflow::with_jobs(jobs, f)?)
 }
 
 /// A CSV writer on stdout (buffered; flush it at the end).

@@ -8,7 +8,7 @@
 //! * `fit`, `recovery`, `many`, `peer`, `speed`: `brtf synth` + `brtf fit`
 //!   (known parameters back, real scans, sample folders, the scipy peer and
 //!   the data of the speed comparison).
-//! * `contract`, `reproduce`, `safety`: what every command reads from a
+//! * `contract`, `reproduce`, `safety`, `hostile`: what every command reads from a
 //!   fit folder, `fits/alu-ggx` rebuilt byte for byte, and no lost result
 //!   or unchecked option.
 //! * `export`, `klems_export`, `klems_fit`: Radiance and Klems exports, and
@@ -23,6 +23,7 @@ mod contract;
 mod eval;
 mod export;
 mod fit;
+mod hostile;
 mod info;
 mod klems_export;
 mod klems_fit;

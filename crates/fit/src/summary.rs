@@ -103,9 +103,14 @@ pub fn summary(result: &FitResult, out: &Path) -> String {
         let shape = result.config.shape();
         let args: Vec<String> = g.material_args.iter().map(|a| format!("{a:.6}")).collect();
         if shape.is_single() {
+            // As Radiance reads it: the *2 types carry their orientation.
+            let strings = match result.config.orientation {
+                [x, y, z] if shape.kind.is_anisotropic() => format!("4 {x} {y} {z} ."),
+                _ => "0".to_string(),
+            };
             let _ = writeln!(
                 s,
-                "\nall-incidence material: void {} {} 0 0 {} {}",
+                "\nall-incidence material: void {} {} {strings} 0 {} {}",
                 shape.kind,
                 result.name,
                 args.len(),

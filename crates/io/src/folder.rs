@@ -47,9 +47,8 @@ impl FolderUpdate {
     }
 
     fn start(target: &Path, keep_content: bool) -> Result<FolderUpdate, IoError> {
-        let (parent, name) = split_target(target)?;
+        let (parent, name, target) = split_target(target)?;
         crate::ensure_folder(&parent)?;
-        let target = parent.join(&name);
         if target.exists() && !target.is_dir() {
             return Err(IoError {
                 path: target,
@@ -205,32 +204,36 @@ pub fn check_replaceable(target: &Path, inputs: &[PathBuf], force: bool) -> Resu
     }
 }
 
-/// Refuses, unless `force`, to write `output` when it is one of `inputs`
-/// (`render gonio --like X --out X`) or, with a `marker`, when it exists
-/// and its first 4 KiB do not hold `marker`: a file this command did not
-/// write, such as a real measurement under `brtf synth`'s file name.
+/// Refuses to write `output` when it is one of `inputs` (after symlinks;
+/// `render gonio --like X --out X`, or a file of a fit folder the command
+/// reads, [`fit_folder_inputs`]), even with `force`; and, unless `force`,
+/// with a `marker`, when it exists and its first 4 KiB do not hold
+/// `marker`: a file this command did not write, such as a real
+/// measurement under `brtf synth`'s file name.
 pub fn check_overwrite(
     output: &Path,
     inputs: &[&Path],
     marker: Option<&str>,
     force: bool,
 ) -> Result<(), IoError> {
-    let refuse = |why: &str| IoError {
+    let refuse = |why: String| IoError {
         path: output.to_path_buf(),
         what: "refusing to overwrite",
-        source: std::io::Error::other(format!("{why}; --force overwrites it")),
+        source: std::io::Error::other(why),
     };
     let Ok(existing) = std::fs::canonicalize(output) else {
         return Ok(());
     };
-    if force {
-        return Ok(());
-    }
     if inputs
         .iter()
         .any(|i| std::fs::canonicalize(i).is_ok_and(|i| i == existing))
     {
-        return Err(refuse("it is an input of this run"));
+        return Err(refuse(
+            "this run reads it (an input, or a file of the fit folder it reads); --force does not change that".into(),
+        ));
+    }
+    if force {
+        return Ok(());
     }
     if let Some(marker) = marker {
         let mut head = Vec::new();
@@ -238,12 +241,35 @@ pub fn check_overwrite(
         std::io::Read::read_to_end(&mut std::io::Read::take(file, 4096), &mut head)
             .map_err(fail("cannot read", output))?;
         if !String::from_utf8_lossy(&head).contains(marker) {
-            return Err(refuse(&format!(
-                "it exists and this command did not write it (its header lacks `{marker}`)"
+            return Err(refuse(format!(
+                "it exists and this command did not write it (its header lacks `{marker}`); --force overwrites it"
             )));
         }
     }
     Ok(())
+}
+
+/// The files of the fit folder `dir` that a command reading it must never
+/// replace: `fit.json`, every output its manifest lists as written by a
+/// step other than `step` (`check` writes `check.csv`, for one), and the
+/// measurement files it was fitted to, where [`crate::locate_input`] finds
+/// them from `dir` and `search`.
+pub fn fit_folder_inputs(dir: &Path, step: &str, search: &[PathBuf]) -> Vec<PathBuf> {
+    let fit_json = dir.join("fit.json");
+    let text = std::fs::read_to_string(&fit_json).unwrap_or_default();
+    let value: serde_json::Value = serde_json::from_str(&text).unwrap_or_default();
+    let mut files = vec![fit_json];
+    for output in value["outputs"].as_array().into_iter().flatten() {
+        if let Some(path) = output["path"].as_str()
+            && output["by"].as_str() != Some(step)
+        {
+            files.push(dir.join(path));
+        }
+    }
+    for (recorded, _) in recorded_inputs(&text) {
+        files.extend(crate::locate_input(&recorded, dir, search));
+    }
+    files
 }
 
 /// `provenance.inputs[]` (`path`, `sha256`) of a `fit.json` of any schema.
@@ -264,7 +290,9 @@ fn recorded_inputs(fit_json: &str) -> Vec<(String, String)> {
 
 /// The absolute parent and the file name of `target` (`fits/x` → the
 /// current folder's `fits`, `x`).
-fn split_target(target: &Path) -> Result<(PathBuf, String), IoError> {
+/// The folder `target` as (its parent, its name as text for the hidden
+/// files beside it, the folder itself).
+fn split_target(target: &Path) -> Result<(PathBuf, String, PathBuf), IoError> {
     let absolute = std::path::absolute(target).map_err(fail("cannot resolve", target))?;
     // `x/.` and `x/..` have no plain last name; resolve them through the disk.
     let resolved = match absolute.file_name() {
@@ -272,7 +300,11 @@ fn split_target(target: &Path) -> Result<(PathBuf, String), IoError> {
         None => std::fs::canonicalize(&absolute).map_err(fail("cannot resolve", target))?,
     };
     match (resolved.parent(), resolved.file_name()) {
-        (Some(parent), Some(name)) => Ok((parent.to_path_buf(), name.to_string_lossy().into())),
+        (Some(parent), Some(name)) => Ok((
+            parent.to_path_buf(),
+            name.to_string_lossy().into(),
+            resolved.clone(),
+        )),
         _ => Err(IoError {
             path: target.to_path_buf(),
             what: "cannot use as an output folder",
@@ -292,11 +324,17 @@ impl FolderLock {
     /// Takes the lock or fails at once, naming `target`, when another run
     /// holds it.
     fn take(path: &Path, target: &Path) -> Result<FolderLock, IoError> {
+        crate::refuse_symlink(path)?;
+        let mut options = File::options();
+        options.create(true).truncate(false).write(true);
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::OpenOptionsExt;
+            // A link planted after the check above is not followed either.
+            options.custom_flags(rustix::fs::OFlags::NOFOLLOW.bits() as i32);
+        }
         loop {
-            let file = File::options()
-                .create(true)
-                .truncate(false)
-                .write(true)
+            let file = options
                 .open(path)
                 .map_err(fail("cannot create the lock file", path))?;
             if !try_lock(&file).map_err(fail("cannot lock", path))? {
@@ -429,6 +467,10 @@ fn link_tree(from: &Path, to: &Path) -> Result<(), IoError> {
             continue;
         }
         let kind = entry.file_type().map_err(fail("cannot read", &source))?;
+        if kind.is_symlink() {
+            // A link would let this run write outside the folder.
+            crate::refuse_symlink(&source)?;
+        }
         if kind.is_dir() {
             std::fs::create_dir(&dest).map_err(fail("cannot create folder", &dest))?;
             link_tree(&source, &dest)?;

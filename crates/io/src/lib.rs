@@ -16,7 +16,7 @@
 mod folder;
 mod outputs;
 
-pub use folder::{FolderUpdate, check_overwrite, check_replaceable, leftovers};
+pub use folder::{FolderUpdate, check_overwrite, check_replaceable, fit_folder_inputs, leftovers};
 pub use outputs::{OutputFile, Producer, describe_outputs, folder_files, replace_outputs};
 use sha2::{Digest, Sha256};
 use std::io::Write;
@@ -42,6 +42,22 @@ impl std::fmt::Display for IoError {
 // No `source()`: the message already ends with the system's reason, and
 // anyhow's `{:#}` would print it twice.
 impl std::error::Error for IoError {}
+
+/// Refuses `path` when it is a symbolic link: brtf writes its own files
+/// and folders, never through a link planted in their place (a `plots`
+/// link out of a fit folder, a lock file's link elsewhere).
+pub fn refuse_symlink(path: &Path) -> Result<(), IoError> {
+    match std::fs::symlink_metadata(path) {
+        Ok(m) if m.file_type().is_symlink() => Err(IoError {
+            path: path.to_path_buf(),
+            what: "refusing to write through a symbolic link",
+            source: std::io::Error::other(
+                "brtf writes only real files and folders here; remove the link",
+            ),
+        }),
+        _ => Ok(()),
+    }
+}
 
 /// Creates `dir` and its parents when missing.
 pub fn ensure_folder(dir: &Path) -> Result<(), IoError> {

@@ -114,12 +114,7 @@ fn fit_set(
     let command_line = vec!["brtf.fit (Python)".to_string()];
     let fitted = py.detach(|| -> Result<_, WorkflowError> {
         let job = FitJob::new(&inputs, &settings, name, command_line)?;
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(jobs.unwrap_or(0))
-            .build();
-        let pool =
-            pool.map_err(|e| WorkflowError::Usage(format!("cannot start worker threads: {e}")))?;
-        pool.install(|| job.fit(side, &NoProgress))
+        brtf_workflow::with_jobs(jobs, || job.fit(side, &NoProgress))?
     });
     let result = fitted.map_err(errors::workflow)?.result;
     Ok(fit::Fit::new(result, paths))

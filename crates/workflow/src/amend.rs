@@ -199,8 +199,11 @@ pub fn check_folder(
 ) -> Result<(brtf_trace::CheckReport, PathBuf), WorkflowError> {
     options.validate()?;
     let fit = read_fit(dir)?;
-    let report = brtf_trace::check_fit(&fit, dir, options)?;
     let out = out.map_or_else(|| dir.join("check.csv"), Path::to_path_buf);
+    let inputs = brtf_io::fit_folder_inputs(dir, "check", &options.search_dirs);
+    let inputs: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
+    brtf_io::check_overwrite(&out, &inputs, None, true)?;
+    let report = brtf_trace::check_fit(&fit, dir, options)?;
     if let Some(folder) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
         brtf_io::ensure_folder(folder)?;
     }

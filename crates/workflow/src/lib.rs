@@ -24,6 +24,7 @@ mod error;
 mod folder;
 mod info;
 mod inputs;
+mod jobs;
 mod material;
 mod render;
 mod run;
@@ -39,6 +40,7 @@ pub use error::WorkflowError;
 pub use folder::{FolderWritten, Outputs, save_fit, write_fit_folder};
 pub use info::describe_files;
 pub use inputs::{FitInputs, default_name, is_klems, sample_files};
+pub use jobs::with_jobs;
 pub use material::{read_material_file, solar_band};
 pub use render::{
     GonioRequest, GonioRun, ImageRequest, ImageRun, MaterialSource, RenderMaterial,

@@ -40,6 +40,9 @@ pub struct RenderMaterial {
     pub name: String,
     /// The fit, when the material came from one.
     pub fit: Option<FitResult>,
+    /// The files it was read from, which no output may replace: the
+    /// `.rad` file, or the fit folder's ([`brtf_io::fit_folder_inputs`]).
+    pub inputs: Vec<PathBuf>,
 }
 
 /// Loads `source` for the tracer: a fit folder of any shape (one
@@ -79,13 +82,22 @@ pub fn load_render_material(
         Some(table) => Shader::from_table(table, &options)?,
         None => Shader::new(&material, &options)?,
     };
+    let inputs = match source {
+        MaterialSource::File { path, .. } => vec![path.clone()],
+        MaterialSource::Fit { dir, .. } => brtf_io::fit_folder_inputs(dir, "render", &[]),
+    };
     Ok(RenderMaterial {
         shader,
         material,
         name,
         fit,
+        inputs,
     })
 }
+
+/// The header words of a file `brtf render gonio` wrote: `--force` is
+/// needed to replace any other existing file.
+const GONIO_MARKER: &str = "rendered by brtf render gonio";
 
 /// A virtual gonio-photometer run.
 #[derive(Debug, Clone)]
@@ -151,8 +163,9 @@ pub fn render_gonio(
         let inputs: Vec<&Path> = [request.like.as_deref(), material_file]
             .into_iter()
             .flatten()
+            .chain(material.inputs.iter().map(PathBuf::as_path))
             .collect();
-        brtf_io::check_overwrite(out, &inputs, None, request.force)?;
+        brtf_io::check_overwrite(out, &inputs, Some(GONIO_MARKER), request.force)?;
     }
     let fit_omega = material.fit.as_ref().map(|f| f.options().source_omega);
     let setup = GonioSetup {
@@ -207,7 +220,7 @@ pub fn render_gonio(
             m.sample_name = l.sample_name.clone();
         }
         m.header.push(format!(
-            "# rendered by brtf render gonio: material {name}, beam {} sr, detector {} sr, {} rays per direction, seed {}",
+            "# {GONIO_MARKER}: material {name}, beam {} sr, detector {} sr, {} rays per direction, seed {}",
             setup.source_omega, setup.detector_omega, setup.samples, setup.seed
         ));
         brtf_gonio::write_path(&m, path, format)?;
@@ -308,7 +321,10 @@ pub fn render_image(
             .collect::<Vec<_>>()
             .join("\n")
     });
-    let inputs: Vec<&Path> = material_file.into_iter().collect();
+    let inputs: Vec<&Path> = material_file
+        .into_iter()
+        .chain(material.inputs.iter().map(PathBuf::as_path))
+        .collect();
     for ext in [".hdr", ".png", ".rad", ".vf"] {
         brtf_io::check_overwrite(&with_extension(prefix, ext), &inputs, None, false)?;
     }

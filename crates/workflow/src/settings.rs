@@ -149,6 +149,17 @@ impl FitSettings {
         config.options.variant = self.variant;
         config.options.fresnel_k = self.fresnel_k;
         config.options.source_omega = self.source_omega;
+        if let Some([x, y, z]) = self.orientation {
+            // Radiance projects the vector onto the surface ("illegal
+            // orientation vector" when nothing is left).
+            let along_normal = x.hypot(y) <= 1e-9 * x.hypot(y).hypot(z);
+            if along_normal || ![x, y, z].iter().all(|c| c.is_finite()) {
+                return Err(WorkflowError::Usage(format!(
+                    "--orientation {x},{y},{z}: needs a direction with a part in the surface \
+                     (not zero, not along the normal z)"
+                )));
+            }
+        }
         config.orientation = self.orientation.unwrap_or([1.0, 0.0, 0.0]);
         // Auto's anisotropic candidates fit their orientation unless one is given.
         config.oriented = (auto || kind.is_anisotropic()) && !klems && self.orientation.is_none();

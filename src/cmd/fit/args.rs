@@ -141,8 +141,8 @@ impl FitArgs {
         let orientation = match &self.orientation {
             None => None,
             Some(v) => match <[f64; 3]>::try_from(&v[..]) {
-                Ok(o) if o.iter().any(|c| *c != 0.0) => Some(o),
-                _ => anyhow::bail!("--orientation needs three numbers x,y,z, not all zero"),
+                Ok(o) => Some(o),
+                _ => anyhow::bail!("--orientation needs three numbers x,y,z"),
             },
         };
         Ok(FitSettings {
