@@ -118,3 +118,13 @@ print("caught", caught, np.isnan(v).any())
     assert done.returncode == 0, done.stderr
     assert done.stdout.startswith("caught ")
     assert int(done.stdout.split()[1]) >= 15
+
+
+def test_directions_out_of_range_raise():
+    m = brtf.Material("plastic", rgb=0.5, spec=0.05, roughness=0.1)
+    for theta_out, phi_out in [(float("nan"), 180.0), (-10.0, 180.0), (200.0, 180.0), (30.0, 1e300)]:
+        with pytest.raises(brtf.ModelError, match="out of range"):
+            m.eval(30.0, 0.0, [10.0, theta_out], phi_out)
+    with pytest.raises(brtf.ModelError, match=r"phi_out 1e300: out of range"):
+        m.eval(30.0, 0.0, 30.0, 1e300)
+    assert m.eval(30.0, 0.0, [0.0, 180.0], [-360.0, 360.0]).shape == (2, 3)

@@ -312,3 +312,84 @@ fn absurd_options_are_refused_before_any_work() {
         stderr(&o)
     );
 }
+
+#[test]
+fn endless_or_huge_inputs_are_refused_before_reading() {
+    let root = temp_dir();
+    let examples = repo_path("data/materials/examples.rad");
+    let endless: [&[&str]; 4] = [
+        &["info", "/dev/zero"],
+        &["fit", "/dev/zero", "--model", "metal", "--out", "Z"],
+        &[
+            "eval",
+            "--material",
+            "/dev/zero",
+            "--theta-in",
+            "30",
+            "--phi-in",
+            "0",
+        ],
+        &["info", "."],
+    ];
+    for args in endless {
+        let o = run(root.path(), args);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
+        assert!(err.contains("not a regular file"), "{args:?}: {err}");
+    }
+    // Over the limit (lowered to 1 MiB here): refused from its size.
+    let big = root.path().join("big.txt");
+    let file = std::fs::File::create(&big).unwrap();
+    file.set_len(2 << 20).unwrap();
+    for args in [
+        vec!["info", "big.txt"],
+        vec!["fit", "big.txt", "--model", "metal", "--out", "Z"],
+        vec![
+            "eval",
+            "--material",
+            "big.txt",
+            "--theta-in",
+            "30",
+            "--phi-in",
+            "0",
+        ],
+    ] {
+        let o = Command::new(BRTF)
+            .args(&args)
+            .current_dir(root.path())
+            .env("BRTF_MAX_INPUT_MB", "1")
+            .stdin(Stdio::null())
+            .output()
+            .unwrap();
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
+        assert!(
+            err.contains("larger than brtf reads (1 MiB); set BRTF_MAX_INPUT_MB"),
+            "{args:?}: {err}"
+        );
+    }
+    assert!(!root.path().join("Z").exists());
+    // Within the default limit the same file is read (and refused for its
+    // NUL bytes, with the offset).
+    let o = run(root.path(), &["info", "big.txt"]);
+    assert!(
+        stderr(&o).contains("NUL byte at byte offset 0"),
+        "{}",
+        stderr(&o)
+    );
+    let o = run(
+        root.path(),
+        &[
+            "eval",
+            "--material",
+            s(&examples),
+            "--name",
+            "white_paint",
+            "--theta-in",
+            "30",
+            "--phi-in",
+            "0",
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+}

@@ -348,7 +348,7 @@ fn read_input(
     recipe: &Recipe,
     klems: &KlemsOptions,
 ) -> Result<Vec<Input>, FitSetError> {
-    let bytes = std::fs::read(path).map_err(|source| FitSetError::Io {
+    let bytes = brtf_io::read_input(path).map_err(|source| FitSetError::Io {
         path: path.to_path_buf(),
         source,
     })?;

@@ -43,6 +43,61 @@ impl std::fmt::Display for IoError {
 // anyhow's `{:#}` would print it twice.
 impl std::error::Error for IoError {}
 
+/// The largest input file read, in MiB, unless `BRTF_MAX_INPUT_MB` says
+/// otherwise: far above any real scan or BSDF file, far below a machine's
+/// memory.
+pub const DEFAULT_MAX_INPUT_MB: u64 = 1024;
+
+/// Opens an input file after checking that it is a regular file (not a
+/// device, pipe or folder, which may never end) of at most the input
+/// limit ([`DEFAULT_MAX_INPUT_MB`] or `BRTF_MAX_INPUT_MB`); returns it
+/// with the limit in bytes. The errors say which limit and how to raise
+/// it; the caller adds the path.
+pub fn open_input(path: &Path) -> std::io::Result<(std::fs::File, u64)> {
+    let file = std::fs::File::open(path)?;
+    let meta = file.metadata()?;
+    if !meta.is_file() {
+        return Err(std::io::Error::other(
+            "not a regular file (a folder, device or pipe); give a measurement file",
+        ));
+    }
+    let limit = input_limit();
+    if meta.len() > limit {
+        return Err(too_big());
+    }
+    Ok((file, limit))
+}
+
+/// Reads an input file whole ([`open_input`]'s checks); the read is
+/// bounded too, in case the file grows meanwhile.
+pub fn read_input(path: &Path) -> std::io::Result<Vec<u8>> {
+    let (file, limit) = open_input(path)?;
+    let mut bytes = Vec::new();
+    std::io::Read::read_to_end(&mut std::io::Read::take(file, limit + 1), &mut bytes)?;
+    if bytes.len() as u64 > limit {
+        return Err(too_big());
+    }
+    Ok(bytes)
+}
+
+fn input_limit_mb() -> u64 {
+    std::env::var("BRTF_MAX_INPUT_MB")
+        .ok()
+        .and_then(|v| v.trim().parse::<u64>().ok())
+        .unwrap_or(DEFAULT_MAX_INPUT_MB)
+}
+
+fn input_limit() -> u64 {
+    input_limit_mb().saturating_mul(1 << 20)
+}
+
+fn too_big() -> std::io::Error {
+    std::io::Error::other(format!(
+        "larger than brtf reads ({} MiB); set BRTF_MAX_INPUT_MB to raise the limit",
+        input_limit_mb()
+    ))
+}
+
 /// Refuses `path` when it is a symbolic link: brtf writes its own files
 /// and folders, never through a link planted in their place (a `plots`
 /// link out of a fit folder, a lock file's link elsewhere).

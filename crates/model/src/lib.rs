@@ -58,7 +58,7 @@ pub use kind::{MaterialKind, Variant};
 pub use material::{FTINY, MAX_ARGS, Material, ModelError, check_args};
 pub use options::{
     EvalOptions, FRESNEL_K_CLASSIC, FRESNEL_K_PYRADIANCE, OptionError, check_incidence,
-    parse_fresnel_k,
+    check_outgoing, parse_fresnel_k,
 };
 pub use rng::Rng;
 pub use words::{OptionWords, WordError, parse_word};

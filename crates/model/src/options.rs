@@ -98,9 +98,20 @@ impl OptionError {
         }
         Err(OptionError {
             option,
-            value: value.to_string(),
+            value: short_number(value),
             allowed,
         })
+    }
+}
+
+/// `value` as a message shows it: as Rust prints it, but in exponent
+/// form when that would take more than a few digits (`1e300`, not 301).
+fn short_number(value: f64) -> String {
+    let plain = value.to_string();
+    if plain.len() > 16 && value.is_finite() {
+        format!("{value:e}")
+    } else {
+        plain
     }
 }
 
@@ -140,9 +151,39 @@ pub fn check_incidence(theta_in: f64, phi_in: f64) -> Result<(), OptionError> {
     )
 }
 
+/// Checks a direction seen from, given by a user: θ_out in [0, 180]°
+/// (beyond 90°: the back side), φ_out within ±360°.
+pub fn check_outgoing(theta_out: f64, phi_out: f64) -> Result<(), OptionError> {
+    OptionError::check(
+        "theta_out",
+        theta_out,
+        (0.0..=180.0).contains(&theta_out),
+        "0 ≤ θ_out ≤ 180 degrees (beyond 90: the back side)",
+    )?;
+    OptionError::check(
+        "phi_out",
+        phi_out,
+        (-360.0..=360.0).contains(&phi_out),
+        "-360 to 360 degrees",
+    )
+}
+
 #[cfg(test)]
 mod validation_tests {
     use super::*;
+
+    #[test]
+    fn huge_values_print_short_in_messages() {
+        let e = check_outgoing(30.0, 1e300).unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "phi_out 1e300: out of range; allowed: -360 to 360 degrees"
+        );
+        let e = check_outgoing(181.5, 0.0).unwrap_err().to_string();
+        assert!(e.starts_with("theta_out 181.5: out of range"), "{e}");
+        assert!(check_outgoing(f64::NAN, 0.0).is_err());
+        assert_eq!(check_outgoing(180.0, -360.0), Ok(()));
+    }
 
     #[test]
     fn out_of_range_settings_name_option_value_and_range() {

@@ -43,7 +43,8 @@ fn rows(result: &FitResult, fit_dir: &Path) -> Result<Vec<PatchRow>, String> {
         if cache.as_ref().is_none_or(|(p, _, _)| *p != input.path) {
             let path = brtf_io::locate_input(&input.path, fit_dir, &[])
                 .ok_or_else(|| format!("{}: Klems file not found", input.path))?;
-            let bytes = std::fs::read(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+            let bytes =
+                brtf_io::read_input(&path).map_err(|e| format!("{}: {e}", path.display()))?;
             cache = Some((input.path.clone(), bytes, path));
         }
         let (_, bytes, path) = cache.as_ref().expect("just filled");

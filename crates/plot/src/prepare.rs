@@ -399,7 +399,7 @@ pub fn load(
         )
     })?;
     let bytes =
-        std::fs::read(&path).map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
+        brtf_io::read_input(&path).map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
     let mut warnings = Vec::new();
     if !input.sha256.is_empty() && brtf_io::sha256_hex(&bytes) != input.sha256 {
         warnings.push(format!(

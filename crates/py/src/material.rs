@@ -339,6 +339,9 @@ impl Material {
             po.as_slice()?,
         );
         check_incidences(ti, pi)?;
+        for (&t, &p) in to.iter().zip(po) {
+            brtf_model::check_outgoing(t, p).map_err(|e| errors::model(e.to_string()))?;
+        }
         let mut out = vec![0.0; 3 * to.len()];
         if !to.is_empty() {
             py.detach(|| self.eval_rows(ti, pi, to, po, &mut out));

@@ -336,7 +336,7 @@ fn fitted_directions(
         return Ok(model_grid(report, floor, beam_mask(fit)));
     };
     let data = |e: String| CheckError::Data(format!("{}: {e}", path.display()));
-    let bytes = std::fs::read(&path).map_err(|e| data(e.to_string()))?;
+    let bytes = brtf_io::read_input(&path).map_err(|e| data(e.to_string()))?;
     let prepared = brtf_fit::prepare_input(&fit.recipe, input, &bytes, &path)
         .map_err(|e| data(e.to_string()))?;
     let channels = prepared.channels();

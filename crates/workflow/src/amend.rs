@@ -154,7 +154,7 @@ pub fn export_klems_of_material(
 ) -> Result<Amended, WorkflowError> {
     eval.validate()?;
     let (name, material) = crate::read_material_file(path, name)?;
-    let bytes = std::fs::read(path).map_err(|source| brtf_io::IoError {
+    let bytes = brtf_io::read_input(path).map_err(|source| brtf_io::IoError {
         path: path.to_path_buf(),
         what: "cannot read",
         source,

@@ -13,13 +13,16 @@ pub fn read_material_file(
     name: Option<&str>,
 ) -> Result<(String, Composite), WorkflowError> {
     let shown = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| {
+    let fail = |source| {
         WorkflowError::Io(brtf_io::IoError {
             path: path.to_path_buf(),
             what: "cannot read material file",
             source,
         })
-    })?;
+    };
+    let bytes = brtf_io::read_input(path).map_err(fail)?;
+    let text = String::from_utf8(bytes)
+        .map_err(|_| fail(std::io::Error::other("stream did not contain valid UTF-8")))?;
     let primitives = brtf_radiance::parse_primitives(&text, &shown)?;
     Ok(brtf_radiance::select_composite(&primitives, name, &shown)?)
 }

@@ -95,7 +95,7 @@ pub fn read_sample_name(bytes: &[u8], name: impl AsRef<Path>) -> Option<String> 
 pub fn read_sample_name_at(path: impl AsRef<Path>) -> std::io::Result<Option<String>> {
     use std::io::Read;
     let path = path.as_ref();
-    let mut file = std::fs::File::open(path)?;
+    let (mut file, limit) = brtf_io::open_input(path)?;
     let mut bytes = Vec::new();
     let mut want = 64 * 1024;
     loop {
@@ -106,7 +106,8 @@ pub fn read_sample_name_at(path: impl AsRef<Path>) -> std::io::Result<Option<Str
         let at_end = bytes.len() < want;
         let body = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(&bytes);
         // A prefix will do once its header ends with a whole line.
-        if at_end || header_end(body).is_some_and(|end| body[..end].ends_with(b"\n")) {
+        let whole_header = header_end(body).is_some_and(|end| body[..end].ends_with(b"\n"));
+        if at_end || whole_header || want as u64 > limit {
             return Ok(read_sample_name(&bytes, path));
         }
         want *= 4;
@@ -192,7 +193,7 @@ pub fn is_xml(bytes: &[u8]) -> bool {
 }
 
 pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>, ReadError> {
-    std::fs::read(path).map_err(|source| ReadError::Io {
+    brtf_io::read_input(path).map_err(|source| ReadError::Io {
         path: path.to_path_buf(),
         source,
     })
