@@ -393,3 +393,25 @@ fn endless_or_huge_inputs_are_refused_before_reading() {
     );
     assert!(o.status.success(), "{}", stderr(&o));
 }
+
+#[test]
+fn an_xml_element_with_absurd_attribute_counts_is_refused() {
+    let root = temp_dir();
+    let attributes: Vec<String> = (0..200_000).map(|i| format!("a{i}=\"1\"")).collect();
+    let text = format!(
+        "<?xml version=\"1.0\"?>\n<!-- x=1 y=2 -->\n<WindowElement {}></WindowElement>\n",
+        attributes.join(" ")
+    );
+    std::fs::write(root.path().join("crowded.xml"), text).unwrap();
+    let o = run(root.path(), &["info", "crowded.xml"]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("crowded.xml:3:") && err.contains("an element with 200000 attributes"),
+        "{err}"
+    );
+    // The real fabrics still read.
+    let fabric = repo_path("../shared/data/lbnl-frads-klems-fabrics/klems_aniso_high.xml");
+    let o = run(root.path(), &["info", s(&fabric)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}

@@ -32,6 +32,18 @@ pub fn read_bytes(bytes: &[u8], name: impl AsRef<Path>) -> Result<KlemsBsdf, Rea
 /// Parses in-memory text; `name` is used in errors.
 pub fn read_str(text: &str, name: impl AsRef<Path>) -> Result<KlemsBsdf, ReadError> {
     let name = name.as_ref();
+    if let Some((line, count)) = crowded_element(text) {
+        return Err(parse_error(
+            name,
+            line,
+            ParseErrorKind::Klems {
+                element: "?xml".into(),
+                problem: KlemsProblem::Xml(format!(
+                    "an element with {count} attributes (at most {MAX_ATTRIBUTES} are read)"
+                )),
+            },
+        ));
+    }
     let doc = Document::parse(text).map_err(|e| {
         let line = (e.pos().row as usize).max(1);
         parse_error(
@@ -44,6 +56,49 @@ pub fn read_str(text: &str, name: impl AsRef<Path>) -> Result<KlemsBsdf, ReadErr
         )
     })?;
     Reader { doc: &doc, name }.read()
+}
+
+/// Attributes per element beyond which a file is refused: a BSDF file's
+/// elements have a handful, and the XML parser's duplicate check costs
+/// the square of their number (200 000 took over a minute).
+const MAX_ATTRIBUTES: usize = 1000;
+
+/// The line and attribute count of the first element with more than
+/// [`MAX_ATTRIBUTES`] attributes, in one pass: `=` signs outside quotes
+/// inside a start tag (comments, `<!…>` and `<?…?>` skipped; the text
+/// between tags, most of a BSDF file, is skipped with `find`).
+fn crowded_element(text: &str) -> Option<(usize, usize)> {
+    let bytes = text.as_bytes();
+    let mut at = 0;
+    while let Some(found) = text[at..].find('<') {
+        let start = at + found;
+        if text[start..].starts_with("<!--") {
+            at = text[start..]
+                .find("-->")
+                .map_or(text.len(), |end| start + end + 3);
+            continue;
+        }
+        at = start + 1;
+        if matches!(bytes.get(at), Some(b'!' | b'?')) {
+            continue;
+        }
+        let (mut quote, mut count) = (None, 0);
+        while at < bytes.len() {
+            match (bytes[at], quote) {
+                (b'"' | b'\'', None) => quote = Some(bytes[at]),
+                (q, Some(open)) if q == open => quote = None,
+                (b'=', None) => count += 1,
+                (b'>', None) => break,
+                _ => {}
+            }
+            at += 1;
+        }
+        if count > MAX_ATTRIBUTES {
+            let line = 1 + bytes[..start].iter().filter(|&&b| b == b'\n').count();
+            return Some((line, count));
+        }
+    }
+    None
 }
 
 struct Reader<'a, 'input> {
