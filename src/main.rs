@@ -50,23 +50,23 @@ enum Command {
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
-/// mimalloc v2's `mi_option_purge_delay` (libmimalloc-sys names no constant).
-const MI_OPTION_PURGE_DELAY: libmimalloc_sys::mi_option_t = 15;
-
 #[allow(unsafe_code)]
 fn tune_allocator() {
     // SAFETY: stores of two options, before any other thread is started.
     unsafe {
         libmimalloc_sys::mi_option_set(libmimalloc_sys::mi_option_large_os_pages, 1);
-        libmimalloc_sys::mi_option_set(MI_OPTION_PURGE_DELAY, -1);
+        // 15: mimalloc v2's `mi_option_purge_delay` (libmimalloc-sys names no constant).
+        libmimalloc_sys::mi_option_set(15, -1);
     }
 }
 
 /// Exit codes (docs/outputs.md): 0 on success and when the reader of
 /// standard output has gone (as ripgrep), 1 on every error, the command
-/// line's included; `--help` and `--version` exit 0.
+/// line's included; `--help` and `--version` exit 0; Ctrl-C and kill: 130, 143.
 fn main() {
     tune_allocator();
+    // Ctrl-C and kill remove the staging folder and lock of a run.
+    let _ = brtf_io::clean_up_on_signals();
     // `--theta-cap -5` is a value, not an unknown option, in every command.
     fn negative_numbers(c: clap::Command) -> clap::Command {
         c.allow_negative_numbers(true)

@@ -415,3 +415,43 @@ fn an_xml_element_with_absurd_attribute_counts_is_refused() {
     let o = run(root.path(), &["info", s(&fabric)]);
     assert!(o.status.success(), "{}", stderr(&o));
 }
+
+#[test]
+fn ctrl_c_and_kill_remove_the_staging_folder_and_the_lock() {
+    let root = temp_dir();
+    let golden = repo_path("../shared/data/rgl-epfl-pgII-raw/golden_paper.txt");
+    assert!(golden.is_file(), "{} is missing", golden.display());
+    let leftovers = |dir: &Path| -> Vec<String> {
+        std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n.contains(".brtf-"))
+            .collect()
+    };
+    for (signal, code) in [("-INT", 130), ("-TERM", 143)] {
+        let mut child = Command::new(BRTF)
+            .args(["fit", s(&golden), "--model", "auto", "--out", "S"])
+            .current_dir(root.path())
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        // Signal once the run is writing (its staging folder exists).
+        let started = std::time::Instant::now();
+        while !leftovers(root.path()).iter().any(|n| n.contains("stage")) {
+            assert!(child.try_wait().unwrap().is_none(), "the fit ended first");
+            assert!(started.elapsed().as_secs() < 60, "no staging folder");
+            std::thread::sleep(std::time::Duration::from_millis(5));
+        }
+        let killed = Command::new("kill")
+            .args([signal, &child.id().to_string()])
+            .status()
+            .unwrap();
+        assert!(killed.success());
+        let status = child.wait().unwrap();
+        assert_eq!(status.code(), Some(code), "{signal}: {status:?}");
+        assert_eq!(leftovers(root.path()), Vec::<String>::new(), "{signal}");
+        assert!(!root.path().join("S").exists());
+    }
+}

@@ -72,6 +72,7 @@ impl FolderUpdate {
             .tempdir_in(&parent)
             .map_err(fail("cannot create a staging folder in", &parent))?
             .keep();
+        crate::interrupt::register(&staging);
         let update = FolderUpdate {
             target,
             staging,
@@ -115,6 +116,7 @@ impl FolderUpdate {
                 .map_err(fail("cannot move the new folder into", &self.target))?;
         }
         sync_dir(parent);
+        crate::interrupt::unregister(&self.staging);
         self.committed = true;
         self.lock.release();
         Ok(())
@@ -125,6 +127,7 @@ impl Drop for FolderUpdate {
     fn drop(&mut self) {
         if !self.committed && !self.in_place {
             remove_tree(&self.staging);
+            crate::interrupt::unregister(&self.staging);
         }
         if !self.committed {
             self.lock.release();
@@ -350,6 +353,7 @@ impl FolderLock {
             // A run that finished between our open and our lock removed the
             // file we locked; lock the file now at the path instead.
             if same_file(&file, path) {
+                crate::interrupt::register(path);
                 return Ok(FolderLock {
                     path: path.to_path_buf(),
                     file: Some(file),
@@ -362,6 +366,7 @@ impl FolderLock {
     fn release(&mut self) {
         if let Some(file) = self.file.take() {
             let _ = std::fs::remove_file(&self.path);
+            crate::interrupt::unregister(&self.path);
             drop(file);
         }
     }

@@ -14,9 +14,11 @@
 //! each crate can wrap them in its own error type.
 
 mod folder;
+mod interrupt;
 mod outputs;
 
 pub use folder::{FolderUpdate, check_overwrite, check_replaceable, fit_folder_inputs, leftovers};
+pub use interrupt::clean_up_on_signals;
 pub use outputs::{OutputFile, Producer, describe_outputs, folder_files, replace_outputs};
 use sha2::{Digest, Sha256};
 use std::io::Write;
