@@ -122,7 +122,7 @@ pub struct GonioRequest {
     pub channels: Option<Channels>,
     /// The measurement file written (`.mpc`, else Mountain), if any.
     pub out: Option<PathBuf>,
-    /// Overwrite `out` even when it is an input.
+    /// Replace an existing `out` this command did not write (never an input).
     pub force: bool,
 }
 

@@ -61,7 +61,7 @@ pub(crate) struct GonioArgs {
     /// Worker threads [default: all cores].
     #[arg(long)]
     pub jobs: Option<usize>,
-    /// Overwrite --out even when it is the --like or --material file.
+    /// Replace an existing --out file that brtf render gonio did not write (never an input).
     #[arg(long)]
     pub force: bool,
 }
