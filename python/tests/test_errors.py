@@ -111,13 +111,16 @@ for i, data in enumerate(junk):
         except brtf.BrtfError:
             caught += 1
 m = brtf.Material("metal", rgb=0.5, spec=0.5, roughness=0.1)
-v = m.eval(30, 0, np.array([np.nan, np.inf, -1e300, 720.0]), 0)
-print("caught", caught, np.isnan(v).any())
+try:
+    m.eval(30, 0, np.array([np.nan, np.inf, -1e300, 720.0]), 0)
+except brtf.ModelError:
+    caught += 1
+print("caught", caught)
 """
     done = subprocess.run([sys.executable, "-c", code, str(tmp_path)], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
     assert done.stdout.startswith("caught ")
-    assert int(done.stdout.split()[1]) >= 15
+    assert int(done.stdout.split()[1]) >= 16
 
 
 def test_directions_out_of_range_raise():

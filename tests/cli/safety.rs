@@ -4,8 +4,8 @@
 //!   or the new folder, whole, each time, and no stray file once the next
 //!   run has cleaned up), two fits into one folder, refits and
 //!   `export`/`plot` that remove exactly their own stale files.
-//! * Inputs are never overwritten, and a fit of another sample is not
-//!   replaced, without `--force`; default names from `#sample_name`.
+//! * Inputs are never overwritten, even with `--force`; a fit of another
+//!   sample is not replaced without it; default names from `#sample_name`.
 //! * Standard output closed early (`| head -1`) or full (`/dev/full`).
 //! * Every bad number refused with one line naming option, value and
 //!   range; exit codes; `.rad` validation.
@@ -226,7 +226,7 @@ fn a_refit_export_and_plot_remove_exactly_their_own_stale_files() {
 }
 
 #[test]
-fn inputs_are_never_overwritten_without_force() {
+fn inputs_are_never_overwritten() {
     let root = temp_dir();
     let scan = root.path().join("pab-aluA-st1:+30+0.mpc");
     std::fs::copy(
@@ -253,7 +253,8 @@ fn inputs_are_never_overwritten_without_force() {
     let o = run(root.path(), &gonio);
     assert_eq!(o.status.code(), Some(1));
     assert!(
-        text(&o.stderr).contains("it is an input of this run; --force"),
+        text(&o.stderr).contains("this run reads it")
+            && text(&o.stderr).contains("--force does not"),
         "{}",
         text(&o.stderr)
     );
@@ -297,10 +298,11 @@ fn inputs_are_never_overwritten_without_force() {
         text(&o.stderr)
     );
     assert_eq!(std::fs::read(&scan).unwrap(), original);
-    // --force is the way to overwrite on purpose.
+    // Not even with --force: that replaces only files of the same command.
     let mut forced = gonio.to_vec();
     forced.push("--force");
-    assert!(run(root.path(), &forced).status.success());
+    assert_eq!(run(root.path(), &forced).status.code(), Some(1));
+    assert_eq!(std::fs::read(&scan).unwrap(), original);
 }
 
 #[test]
