@@ -3,8 +3,10 @@ a clear message; nothing crashes the interpreter."""
 
 from __future__ import annotations
 
+import signal
 import subprocess
 import sys
+import time
 
 import numpy as np
 import pytest
@@ -131,3 +133,28 @@ def test_directions_out_of_range_raise():
     with pytest.raises(brtf.ModelError, match=r"phi_out 1e300: out of range"):
         m.eval(30.0, 0.0, 30.0, 1e300)
     assert m.eval(30.0, 0.0, [0.0, 180.0], [-360.0, 360.0]).shape == (2, 3)
+
+
+def test_ctrl_c_stops_a_running_fit(klems_fabric):
+    # A long fit (a Klems side, 512 directions per patch, one thread: ~28 s)
+    # in a child interpreter; SIGINT once the incidences are being fitted
+    # raises KeyboardInterrupt at the next incidence, within seconds.
+    code = """
+import sys, time, brtf
+print("started", flush=True)
+t = time.monotonic()
+try:
+    brtf.fit(sys.argv[1], model="plastic2", side="front", patch_samples=512, jobs=1)
+    print("finished", time.monotonic() - t)
+except KeyboardInterrupt:
+    print("interrupted", time.monotonic() - t)
+"""
+    child = subprocess.Popen([sys.executable, "-c", code, str(klems_fabric)], stdout=subprocess.PIPE, text=True)
+    assert child.stdout.readline().strip() == "started"
+    time.sleep(8.0)
+    signalled = time.monotonic()
+    child.send_signal(signal.SIGINT)
+    out, _ = child.communicate(timeout=60)
+    after = time.monotonic() - signalled
+    assert out.split()[0] == "interrupted", out
+    assert after < 3.0, f"{out}: {after:.1f} s after the signal"

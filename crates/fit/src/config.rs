@@ -268,6 +268,9 @@ pub enum FitError {
     /// Incidences differ in channel count.
     #[error("incidences mix single-channel and RGB data")]
     MixedChannels,
+    /// The caller stopped the run ([`crate::Progress::cancelled`]).
+    #[error("the fit was interrupted")]
+    Interrupted,
     /// The optimiser failed at the start.
     #[error("{origin}: the fit could not start: {reason}")]
     Failed {

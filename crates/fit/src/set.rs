@@ -23,6 +23,12 @@ pub trait Progress: Sync {
     fn end(&self) {}
     /// What is being worked on now (`front side`, `12 samples`).
     fn label(&self, _text: &str) {}
+    /// True when the caller wants the run to stop (Ctrl-C in Python): the
+    /// incidences not yet begun are not fitted, and the run fails with
+    /// [`FitError::Interrupted`].
+    fn cancelled(&self) -> bool {
+        false
+    }
 }
 
 /// Reports nothing.
@@ -467,7 +473,9 @@ fn other_fits(
     data.par_iter()
         .zip(geometry)
         .map(|(d, g)| {
-            let r = fit_incidence_sharing(d, &other_config, g).ok();
+            let r = (!progress.cancelled())
+                .then(|| fit_incidence_sharing(d, &other_config, g).ok())
+                .flatten();
             progress.advance();
             r
         })
@@ -538,6 +546,9 @@ fn fit_all(
             data.par_iter()
                 .enumerate()
                 .map(|(i, d)| {
+                    if progress.cancelled() {
+                        return Err(FitError::Interrupted);
+                    }
                     let r = fit_incidence_sharing(d, config, &geometry[i]);
                     progress.advance();
                     r
@@ -548,6 +559,11 @@ fn fit_all(
             // With one incidence the all-incidence fit is that fit.
             if data.len() < 2 {
                 return None;
+            }
+            // Once begun it runs to its end (on a thread of its own when
+            // there are two).
+            if progress.cancelled() {
+                return Some(Err(FitError::Interrupted));
             }
             let r = fit_global_sharing(data, config, geometry);
             progress.advance();

@@ -1,8 +1,6 @@
-//! `brtf._brtf`: the native module of the Python package `brtf`
-//! (`python/brtf`). It only converts between Python/numpy and the brtf
-//! crates: the logic is theirs. Angles are degrees, as on the command line.
-//! `python/brtf/_python.py` adds what is plain Python: `brtf.fit`'s inputs,
-//! `Material.from_rad`'s file, dicts from `to_dict()`, every `repr`.
+//! `brtf._brtf`, the native module of the Python package `brtf`: it converts between
+//! Python/numpy and the brtf crates (angles in degrees); `python/brtf/_python.py` adds
+//! the plain-Python parts (`brtf.fit`'s inputs, `Material.from_rad`'s file, every `repr`).
 // pyo3's macros expand to `unsafe` blocks; this crate writes none itself.
 #![allow(unsafe_code)]
 
@@ -11,10 +9,10 @@ mod fit;
 mod material;
 mod measurement;
 
-use brtf_fit::NoProgress;
 use brtf_gonio::klems::{Side, Sides};
 use brtf_workflow::{FitInputs, FitJob, WorkflowError};
 use pyo3::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Fits a Radiance model to the measurement files `paths`, as `brtf fit`
 /// does: one fit per incidence, one for all, and the θ_in table (`brtf.fit`
@@ -109,15 +107,37 @@ fn fit_set(
             }
         }));
     }
-    // Every file read and fitted on `jobs` threads (all cores by
-    // default), the GIL released.
+    // Read and fitted on `jobs` threads, the GIL released; this thread
+    // watches for Ctrl-C meanwhile and stops the fit at the next incidence.
     let command_line = vec!["brtf.fit (Python)".to_string()];
-    let fitted = py.detach(|| -> Result<_, WorkflowError> {
-        let job = FitJob::new(&inputs, &settings, name, command_line)?;
-        brtf_workflow::with_jobs(jobs, || job.fit(side, &NoProgress))?
-    });
+    let cancel = Cancel(AtomicBool::new(false));
+    let fitted = std::thread::scope(|scope| {
+        let worker = scope.spawn(|| -> Result<_, WorkflowError> {
+            let job = FitJob::new(&inputs, &settings, name, command_line)?;
+            brtf_workflow::with_jobs(jobs, || job.fit(side, &cancel))?
+        });
+        while !worker.is_finished() {
+            py.detach(|| std::thread::sleep(std::time::Duration::from_millis(20)));
+            if let Err(interrupt) = py.check_signals() {
+                cancel.0.store(true, Ordering::Relaxed);
+                let _ = py.detach(|| worker.join());
+                return Err(interrupt);
+            }
+        }
+        py.detach(|| worker.join())
+            .map_err(|_| pyo3::exceptions::PyRuntimeError::new_err("the fit thread panicked"))
+    })?;
     let result = fitted.map_err(errors::workflow)?.result;
     Ok(fit::Fit::new(result, paths))
+}
+
+/// A fit's progress that only carries the stop request of Ctrl-C.
+struct Cancel(AtomicBool);
+
+impl brtf_fit::Progress for Cancel {
+    fn cancelled(&self) -> bool {
+        self.0.load(Ordering::Relaxed)
+    }
 }
 
 #[pymodule]
