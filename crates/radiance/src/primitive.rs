@@ -322,83 +322,28 @@ pub fn material_from_primitive(p: &Primitive, path: &str) -> Result<Material, Ra
     Material::new(kind, &p.reals, orientation).map_err(|e| err(format!("{kind} `{}`: {e}", p.name)))
 }
 
-/// Picks the material called `name`, or the only Ward-type material in the file.
+/// Picks the material called `name`, or the file's one top material, as
+/// [`crate::select_composite`] does, when it is one primitive (not a mixture).
 pub fn select_material(
     primitives: &[Primitive],
     name: Option<&str>,
     path: &str,
 ) -> Result<(String, Material), RadError> {
-    let is_ward = |p: &&Primitive| p.kind.parse::<MaterialKind>().is_ok();
-    let is_theta_export = |p: &&Primitive| {
-        p.kind == "BRTDfunc" && p.strings.iter().any(|s| s.ends_with("-theta.cal"))
-    };
-    let chosen = match name {
-        Some(name) => primitives
-            .iter()
-            .find(|p| p.name == name)
-            .ok_or_else(|| RadError {
-                path: path.to_string(),
-                line: 1,
-                message: format!("no primitive named `{name}` in the file"),
-            })?,
-        None => {
-            let candidates: Vec<&Primitive> = primitives.iter().filter(is_ward).collect();
-            match candidates.as_slice() {
-                [one] => *one,
-                [] => {
-                    let theta = primitives.iter().find(is_theta_export);
-                    return Err(RadError {
-                        path: path.to_string(),
-                        line: theta.map_or(1, |p| p.line),
-                        message: match theta {
-                            Some(p) => format!(
-                                "`{}` is brtf's θ_in-dependent export (a BRTDfunc), which brtf \
-                                 cannot evaluate; use the static material beside it ({}.rad) \
-                                 (`brtf render --fit DIR` renders the θ_in-dependent fit)",
-                                p.name, p.name
-                            ),
-                            None => {
-                                "no plastic, metal, trans, plastic2, metal2 or trans2 material \
-                                     in the file"
-                                    .into()
-                            }
-                        },
-                    });
-                }
-                many => {
-                    let names: Vec<&str> = many.iter().map(|p| p.name.as_str()).collect();
-                    return Err(RadError {
-                        path: path.to_string(),
-                        line: many[1].line,
-                        message: format!(
-                            "several materials ({}); choose one with --name",
-                            names.join(", ")
-                        ),
-                    });
-                }
-            }
-        }
-    };
-    // `void alias new old`: the material of `old`, under the name asked for.
-    let mut target = chosen;
-    for _ in 0..primitives.len() {
-        if target.kind != "alias" {
-            break;
-        }
-        let reference = &target.strings[0];
-        target = primitives
-            .iter()
-            .find(|p| &p.name == reference && p.line < target.line)
-            .ok_or_else(|| RadError {
-                path: path.to_string(),
-                line: target.line,
-                message: format!(
-                    "alias `{}`: no material `{reference}` before it",
-                    target.name
-                ),
-            })?;
+    let (name, composite) = crate::select_composite(primitives, name, path)?;
+    match composite.single() {
+        Some(m) => Ok((name, *m)),
+        None => Err(RadError {
+            path: path.to_string(),
+            line: primitives
+                .iter()
+                .rfind(|p| p.name == name)
+                .map_or(1, |p| p.line),
+            message: format!(
+                "`{name}` is a mixture of {} primitives; one primitive is needed here",
+                composite.components().len()
+            ),
+        }),
     }
-    Ok((chosen.name.clone(), material_from_primitive(target, path)?))
 }
 
 /// `text` made a Radiance identifier that is also a safe file stem: ASCII
