@@ -1,6 +1,6 @@
 //! brtf-gonio: gonio-photometer measurement files.
 //!
-//! Reads and writes the two text formats of `gonio-formats.md` — the
+//! Reads and writes the two text formats of `../shared/spec/gonio-formats.md` — the
 //! Fraunhofer ISE `.mpc` and the pab-opto "Mountain" (pgII) format — into
 //! one data model, [`Measurement`], and computes what a fitter and a human
 //! need from it: per-sample solid angles, data-side hemispherical
