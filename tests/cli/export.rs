@@ -166,6 +166,8 @@ fn result_of(
                     conversion: brtf_fit::Conversion::Bsdf,
                     samples: 2000,
                     klems: None,
+                    phi_turn_deg: 0.0,
+                    peak_arc_deg: None,
                 })
                 .collect(),
         },

@@ -18,6 +18,7 @@
 use crate::adequacy::{
     Adequacy, ENERGY_TOLERANCE, PEAK_TOLERANCE_DEG, RESIDUAL_KIND_TOLERANCE, ResidualCheck,
 };
+use crate::align::bright_centroid;
 use crate::config::FitConfig;
 use crate::data::IncidenceData;
 use crate::recipe::PreparedMeasurement;
@@ -26,9 +27,6 @@ use brtf_gonio::Hemisphere;
 use brtf_model::{Composite, CompositeBsdf, Directions, RgbBatch, composite_albedo};
 use glam::DVec3;
 use rayon::prelude::*;
-
-/// The brightest fraction of the fitted samples whose centroid is the peak.
-const PEAK_FRACTION: f64 = 0.002;
 
 /// The material of `report` with `config`'s orientation, ready to evaluate.
 pub(crate) fn fitted_bsdf(config: &FitConfig, report: &FitReport) -> Option<CompositeBsdf> {
@@ -189,30 +187,21 @@ pub(crate) fn diagnose(
 /// fitter's view of them (their directions).
 fn peak_offset(prepared: &PreparedMeasurement, data: &IncidenceData, model: &[f64]) -> Option<f64> {
     let channels = prepared.channels();
-    let samples: Vec<(DVec3, f64, f64)> = data
+    let (dirs, (data_values, model_values)): (Vec<DVec3>, (Vec<f64>, Vec<f64>)) = data
         .samples
         .iter()
         .zip(model)
-        .map(|(s, &f)| (s.view, luminance(s.value, channels), f))
-        .filter(|(_, y, _)| y.is_finite())
-        .collect();
-    if samples.len() < 10 {
-        return None;
-    }
-    let count = ((samples.len() as f64 * PEAK_FRACTION).ceil() as usize).clamp(3, samples.len());
-    let centroid = |value: &dyn Fn(&(DVec3, f64, f64)) -> f64| -> (DVec3, f64) {
-        let values: Vec<f64> = samples.iter().map(value).collect();
-        let top = brightest(&values, count);
-        let sum: DVec3 = top.iter().map(|&i| samples[i].0 * values[i].max(0.0)).sum();
-        let brightest = values[top[0]];
-        let mut all = values;
-        let mid = all.len() / 2;
-        let median = *all.select_nth_unstable_by(mid, f64::total_cmp).1;
-        (sum.normalize_or_zero(), brightest / median.max(1e-300))
+        .map(|(s, &f)| (s.view, (luminance(s.value, channels), f)))
+        .filter(|(_, (y, _))| y.is_finite())
+        .unzip();
+    let ((data_peak, contrast), (model_peak, _)) = match rayon::join(
+        || bright_centroid(&dirs, &data_values),
+        || bright_centroid(&dirs, &model_values),
+    ) {
+        (Some(d), Some(m)) => (d, m),
+        _ => return None,
     };
-    let ((data_peak, contrast), (model_peak, _)) =
-        rayon::join(|| centroid(&|s| s.1), || centroid(&|s| s.2));
-    if contrast < 2.0 || data_peak == DVec3::ZERO || model_peak == DVec3::ZERO {
+    if contrast < 2.0 {
         return None;
     }
     Some(
@@ -222,18 +211,6 @@ fn peak_offset(prepared: &PreparedMeasurement, data: &IncidenceData, model: &[f6
             .acos()
             .to_degrees(),
     )
-}
-
-/// The indices of the `count` largest `values`, largest first and in index
-/// order among equals: the head of a stable sort by decreasing value,
-/// found by a selection and a sort of the head alone. `count` ≥ 1.
-fn brightest(values: &[f64], count: usize) -> Vec<usize> {
-    let brighter = |a: &usize, b: &usize| values[*b].total_cmp(&values[*a]).then(a.cmp(b));
-    let mut order: Vec<usize> = (0..values.len()).collect();
-    order.select_nth_unstable_by(count - 1, brighter);
-    order.truncate(count);
-    order.sort_unstable_by(brighter);
-    order
 }
 
 /// The residual kind of the second fit: log for absolute residuals,
@@ -302,30 +279,4 @@ pub(crate) fn warnings(a: &Adequacy) -> Vec<crate::FitWarning> {
         });
     }
     warnings
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_brightest_are_the_head_of_a_stable_sort() {
-        // Many ties, negative values and both zeros, in a scrambled order.
-        let values: Vec<f64> = (0..5000u64)
-            .map(|i| {
-                let h = i.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 40;
-                match h % 7 {
-                    0 => 0.0,
-                    1 => -0.0,
-                    2 => -((h % 13) as f64),
-                    _ => (h % 97) as f64 * 0.25,
-                }
-            })
-            .collect();
-        let mut stable: Vec<usize> = (0..values.len()).collect();
-        stable.sort_by(|&a, &b| values[b].total_cmp(&values[a]));
-        for count in [1, 3, 10, 11, 250, 4999, 5000] {
-            assert_eq!(brightest(&values, count), stable[..count], "count {count}");
-        }
-    }
 }

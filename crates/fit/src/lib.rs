@@ -30,6 +30,7 @@
 //! This is the only crate that uses nalgebra and levenberg-marquardt.
 
 mod adequacy;
+mod align;
 mod auto;
 mod config;
 mod data;
@@ -60,6 +61,7 @@ mod validate;
 pub use adequacy::{
     Adequacy, ENERGY_TOLERANCE, PEAK_TOLERANCE_DEG, RESIDUAL_KIND_TOLERANCE, ResidualCheck,
 };
+pub use align::{AzimuthRule, MAX_TURN_DEG, MIN_ARC_DEG};
 pub use auto::{AutoChoice, CandidateRecord, FOLDS, MARGIN_POINTS, MARGIN_RELATIVE};
 pub use brtf_gonio::Gate;
 pub use config::{FitConfig, FitError, KnownReflectance, ModelChoice, RobustLoss};

@@ -20,10 +20,12 @@ use std::ops::Range;
 /// How a model value m is compared with a measured value y.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 pub enum ResidualKind {
-    /// `m − y`, weighted by solid angle: the squared error integrated over
-    /// the sphere. The peak counts most, and the fitted lobe keeps the
-    /// data's energy even when the model cannot follow the data's shape.
-    /// The default.
+    /// `m − y` in the file's own quantity (times |cos θ_out| for a raw
+    /// signal or DSF, whose values are the BSDF times it), weighted by
+    /// solid angle: the squared error integrated over the sphere, in the
+    /// quantity the instrument measured. The peak counts most, and the
+    /// fitted lobe keeps the data's energy even when the model cannot
+    /// follow the data's shape. The default.
     #[default]
     Absolute,
     /// `(m − y) / sqrt(y² + floor²)`: every direction counts alike; right
@@ -99,10 +101,18 @@ impl Block<'_> {
                 .enumerate()
             {
                 let sw = this.sqrt_weight(first + i, s);
+                // Absolute residuals are taken in the file's own quantity:
+                // for a raw signal or DSF, the BSDF times |cos θ_out|.
+                let cosine = if this.cosine_weighted {
+                    s.view.z.abs()
+                } else {
+                    1.0
+                };
                 for (o, &y) in out.iter_mut().zip(&s.value[..channels]) {
                     *o = match kind {
                         ResidualKind::Relative => sw / (y * y + floor * floor).sqrt(),
-                        ResidualKind::Absolute | ResidualKind::Log => sw,
+                        ResidualKind::Absolute => sw * cosine,
+                        ResidualKind::Log => sw,
                     };
                 }
             }

@@ -14,7 +14,12 @@
 //!    or ÷ the instrument scale K of a known reflectance, or with a free
 //!    fitted scale when neither is known.
 //! 4. **Selections** ([`Gate`]), in order, each with the number it removed.
+//! 5. **Azimuth** ([`AzimuthRule`]): φ_out turned so that the specular
+//!    peak lies in the plane of incidence (see [`crate::align`]); the
+//!    conversion and the selections are then made again in the turned
+//!    frame.
 
+use crate::align::{AzimuthRule, aligning_turn, peak_azimuth};
 use crate::data::{FitSample, GateCount, IncidenceData, Weighting};
 use brtf_gonio::{Gate, GateContext, Measurement, Quantity, SolidAngleSource};
 use glam::DVec3;
@@ -104,6 +109,10 @@ pub struct Recipe {
     /// the model is averaged the same way before it is compared with them.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub patch_average: Option<PatchAveraging>,
+    /// How φ_out is aligned with the plane of incidence (step 5). Fits
+    /// saved without it used the file's frame.
+    #[serde(default = "AzimuthRule::file_frame")]
+    pub azimuth: AzimuthRule,
 }
 
 /// How the model is averaged over Klems patches (see
@@ -159,6 +168,7 @@ impl Recipe {
             selections,
             weights: WeightRule::SolidAngle,
             patch_average: None,
+            azimuth: AzimuthRule::AlignPeak,
         }
     }
 
@@ -179,6 +189,7 @@ impl Recipe {
             selections,
             weights: WeightRule::SolidAngle,
             patch_average: Some(PatchAveraging::default()),
+            azimuth: AzimuthRule::file_frame(),
         }
     }
 }
@@ -408,6 +419,12 @@ pub struct PreparedMeasurement {
     /// Every sample's [`brtf_gonio::Sample::direction`], in file order:
     /// made once, beside the solid angles, for the gates and the fitter.
     pub directions: Vec<DVec3>,
+    /// The turn of φ_out (degrees) the recipe's [`AzimuthRule`] made: the
+    /// measurement's φ_out and the directions are in the turned frame.
+    pub phi_turn_deg: f64,
+    /// How far (degrees of arc) the data's peak lay from the plane of
+    /// incidence before the turn; `None` without a distinct peak.
+    pub peak_arc_deg: Option<f64>,
 }
 
 /// What [`Recipe::convert_and_gate`] makes: the converted measurement,
@@ -428,7 +445,21 @@ impl Recipe {
             || brtf_gonio::solid_angles(&measurement),
             || self.convert_and_gate(&measurement, source),
         );
-        let (mut measurement, conversion, removed_by, directions) = converted?;
+        let mut converted = converted?;
+        let peak = self.peak_azimuth(&converted);
+        let turn = match self.azimuth {
+            AzimuthRule::AlignPeak => aligning_turn(peak),
+            AzimuthRule::Turn { degrees } => degrees,
+        };
+        if turn != 0.0 {
+            // A turn about the normal keeps every cell's solid angle.
+            let mut turned = measurement;
+            for sample in &mut turned.samples {
+                sample.phi_deg = (sample.phi_deg + turn).rem_euclid(360.0);
+            }
+            converted = self.convert_and_gate(&turned, source)?;
+        }
+        let (mut measurement, conversion, removed_by, directions) = converted;
         // The conversions keep the samples and their order.
         measurement.set_solid_angles(&solid_angles);
         let weighting = match (self.weights, solid_angles.source) {
@@ -458,7 +489,35 @@ impl Recipe {
             weighting,
             patch_pairs: None,
             directions,
+            phi_turn_deg: turn,
+            peak_arc_deg: peak.map(|p| p.arc_deg),
         })
+    }
+
+    /// Where the fitted samples' peak lies against the plane of incidence
+    /// (judged on the first channel's converted value, or luminance).
+    fn peak_azimuth(&self, (m, _, removed_by, directions): &Converted) -> Option<crate::align::PeakAzimuth> {
+        if self.patch_average.is_some() {
+            return None;
+        }
+        let channels = m.channels.count();
+        let samples: Vec<(DVec3, f64)> = m
+            .samples
+            .iter()
+            .zip(removed_by)
+            .zip(directions)
+            .filter(|((_, removed), _)| removed.is_none())
+            .map(|((s, _), &d)| {
+                let value = if channels == 3 {
+                    brtf_model::luminance(s.values)
+                } else {
+                    s.values[0]
+                };
+                (d, value)
+            })
+            .filter(|(_, v)| v.is_finite())
+            .collect();
+        peak_azimuth(&samples, m.incidence.phi_deg)
     }
 
     /// The colour conversion, the fitted quantity (step 3) and the gates:

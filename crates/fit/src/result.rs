@@ -36,9 +36,33 @@ pub struct InputFile {
     /// incidence is (one file gives many incidences).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub klems: Option<crate::klems::KlemsPatchRef>,
+    /// The turn of φ_out (degrees) that aligned the file's peak with the
+    /// plane of incidence ([`crate::AzimuthRule`]); 0 in the file's frame.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub phi_turn_deg: f64,
+    /// How far (degrees of arc) the file's peak lay from the plane of
+    /// incidence before any turn; `None` without a distinct peak.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub peak_arc_deg: Option<f64>,
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 impl InputFile {
+    /// The turn of φ_out in words, for summaries: empty in the file's frame.
+    pub fn describe_turn(&self) -> String {
+        match self.peak_arc_deg {
+            _ if self.phi_turn_deg == 0.0 => String::new(),
+            Some(arc) => format!(
+                ", φ_out turned {:+.2}° (the peak lay {arc:.2}° out of the plane of incidence)",
+                self.phi_turn_deg
+            ),
+            None => format!(", φ_out turned {:+.2}°", self.phi_turn_deg),
+        }
+    }
+
     /// True for an incident patch of a Klems file's back side, whose data
     /// are described in a mirrored frame ([`crate::azimuth_from_u`]).
     pub fn is_klems_back_side(&self) -> bool {

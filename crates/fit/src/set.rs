@@ -76,6 +76,8 @@ impl FitSetOptions {
             ..Default::default()
         });
         self.config.min_roughness = crate::klems::MIN_KLEMS_ROUGHNESS;
+        // Patch averages have no peak to align (and a Klems basis no turn).
+        self.recipe.azimuth = crate::AzimuthRule::file_frame();
         self
     }
 }
@@ -376,6 +378,8 @@ fn read_input(
                 conversion: prepared.conversion.clone(),
                 samples,
                 klems: at,
+                phi_turn_deg: prepared.phi_turn_deg,
+                peak_arc_deg: prepared.peak_arc_deg,
             },
             prepared,
         }

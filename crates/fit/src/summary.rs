@@ -24,8 +24,13 @@ pub fn summary(result: &FitResult, out: &Path) -> String {
         for i in &result.provenance.inputs {
             let _ = writeln!(
                 s,
-                "  {}: θ_in {}°, φ_in {}°, {} samples, {}",
-                i.path, i.theta_in, i.phi_in, i.samples, i.conversion
+                "  {}: θ_in {}°, φ_in {}°, {} samples, {}{}",
+                i.path,
+                i.theta_in,
+                i.phi_in,
+                i.samples,
+                i.conversion,
+                i.describe_turn()
             );
         }
     }

@@ -67,6 +67,7 @@ mod tests {
                 selections: vec![Gate::ThetaCap { max_deg: 85.0 }],
                 weights: WeightRule::SolidAngle,
                 patch_average: None,
+                azimuth: crate::AzimuthRule::file_frame(),
             },
             known_reflectance: None,
             interpolation: Interpolation::Pchip,

@@ -96,6 +96,8 @@ fn fit(
                     conversion: brtf_fit::Conversion::Bsdf,
                     samples: 8100,
                     klems: None,
+                    phi_turn_deg: 0.0,
+                    peak_arc_deg: None,
                 })
                 .collect(),
         },

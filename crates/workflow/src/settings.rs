@@ -4,7 +4,7 @@
 use crate::WorkflowError;
 use brtf_fit::klems::IncidenceFilter;
 use brtf_fit::{
-    ColourConversion, FitConfig, FitSetOptions, Interpolation, KnownReflectance, ModelChoice,
+    AzimuthRule, ColourConversion, FitConfig, FitSetOptions, Interpolation, KnownReflectance, ModelChoice,
     Recipe, ResidualKind, RobustLoss, ScaleRule, SelectionOptions, WeightRule,
 };
 use brtf_gonio::Hemispheres;
@@ -54,6 +54,9 @@ pub struct FitSettings {
     pub min_value: Option<f64>,
     /// Mask the pgII holder's shadow.
     pub mask_holder: bool,
+    /// How φ_out is aligned with the plane of incidence (`None`: the
+    /// peak aligned for gonio scans, the file's frame for Klems XML).
+    pub phi_offset: Option<AzimuthRule>,
     /// Beam integral that makes raw-signal files absolute.
     pub beam_integral: Option<f64>,
     /// A known reflectance that makes a raw-signal fit absolute.
@@ -94,6 +97,7 @@ impl FitSettings {
             hemisphere: None,
             min_value: None,
             mask_holder: false,
+            phi_offset: None,
             beam_integral: None,
             rho: None,
             free_scale: false,
@@ -116,6 +120,11 @@ impl FitSettings {
         if !klems && self.incidences.is_some() {
             return Err(WorkflowError::Usage(
                 "--incidences selects the incident patches of Klems BSDF XML files".into(),
+            ));
+        }
+        if klems && self.phi_offset.is_some() {
+            return Err(WorkflowError::Usage(
+                "--phi-offset turns gonio scans; Klems patches keep their basis".into(),
             ));
         }
         if !(1..=MAX_PATCH_SAMPLES).contains(&self.patch_samples) {
@@ -186,6 +195,7 @@ impl FitSettings {
                 selections,
                 weights: self.weights,
                 patch_average: None,
+                azimuth: self.phi_offset.unwrap_or(AzimuthRule::AlignPeak),
             },
             known_reflectance: self.rho.map(|k| (k.rho, k.theta_in)),
             interpolation: self.interpolation,

@@ -92,6 +92,9 @@ pub(crate) struct FitArgs {
     /// Mask the pgII sample holder's shadow: φ_out 270 ± 15° at θ_out ≥ 70°.
     #[arg(long)]
     pub mask_holder: bool,
+    /// Turn of φ_out: `auto` turns it so that the data's specular peak lies in the plane of incidence (when 0.5° or more out of it), a number turns it by that many degrees, 0 keeps the file's frame [default: auto]
+    #[arg(long, value_parser = |s: &str| s.parse::<brtf_fit::AzimuthRule>())]
+    pub phi_offset: Option<brtf_fit::AzimuthRule>,
     /// Beam integral for raw-signal files (makes the fit absolute); overrides the file's.
     #[arg(long)]
     pub beam_integral: Option<f64>,
@@ -163,6 +166,7 @@ impl FitArgs {
             hemisphere: self.hemisphere,
             min_value: self.min_value,
             mask_holder: self.mask_holder,
+            phi_offset: self.phi_offset,
             beam_integral: self.beam_integral,
             rho: self.rho,
             free_scale: self.free_scale,

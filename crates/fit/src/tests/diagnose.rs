@@ -237,6 +237,7 @@ fn prepared(
         selections: gates,
         weights: WeightRule::SolidAngle,
         patch_average: None,
+        azimuth: crate::AzimuthRule::file_frame(),
     };
     recipe
         .prepare(

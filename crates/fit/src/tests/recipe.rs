@@ -22,6 +22,7 @@ fn recipe(selections: Vec<Gate>) -> Recipe {
         selections,
         weights: WeightRule::Uniform,
         patch_average: None,
+        azimuth: crate::AzimuthRule::file_frame(),
     }
 }
 
