@@ -28,6 +28,7 @@ def fit(
     hemisphere: Optional[Literal["front", "back", "both"]] = None,
     min_value: Optional[float] = None,
     mask_holder: bool = False,
+    phi_offset: Optional[Union[float, Literal["auto"]]] = None,
     beam_integral: Optional[float] = None,
     rho: Optional[tuple[float, float]] = None,
     free_scale: bool = False,

@@ -19,7 +19,7 @@ pub(crate) struct ExportArgs {
     pub dir: Option<PathBuf>,
     /// Static material from the parameters at this θ_in (degrees) instead of
     /// the all-incidence fit: the matching incidence's fit, or the θ_in table.
-    #[arg(long, value_name = "THETA")]
+    #[arg(long, value_name = "THETA", conflicts_with = "klems")]
     pub at: Option<f64>,
     /// Material identifier and file stem (default: the fit's name).
     #[arg(long, value_name = "NAME")]
@@ -47,7 +47,7 @@ pub(crate) struct KlemsArgs {
     pub klems: Option<BasisSize>,
     /// With --klems: the static material in this Radiance file instead of a
     /// fit folder (`--name` picks one of several).
-    #[arg(long, value_name = "M.rad", requires = "klems")]
+    #[arg(long, value_name = "M.rad", requires = "klems", conflicts_with = "dir")]
     pub material: Option<PathBuf>,
     #[command(flatten)]
     pub formula: FormulaArgs,
@@ -100,10 +100,6 @@ pub(crate) fn run(args: ExportArgs) -> Result<()> {
 /// `brtf export DIR --klems` or `brtf export --klems --material M.rad`.
 fn run_klems(args: &ExportArgs, basis: BasisSize) -> Result<()> {
     let k = &args.klems;
-    anyhow::ensure!(
-        args.at.is_none(),
-        "--at cannot be used with --klems: each incident patch gets its own θ_in"
-    );
     let mut options = KlemsOptions::new("");
     options.basis = basis.basis();
     options.sampling.samples = k.klems_samples;
@@ -126,10 +122,6 @@ fn run_klems(args: &ExportArgs, basis: BasisSize) -> Result<()> {
         let notes = export.notes;
         return print_written(&brtf_workflow::Amended { files, notes });
     };
-    anyhow::ensure!(
-        args.dir.is_none(),
-        "give either a fit folder or --material, not both"
-    );
     let written = brtf_workflow::export_klems_of_material(
         material_path,
         args.name.as_deref(),

@@ -496,7 +496,10 @@ impl Recipe {
 
     /// Where the fitted samples' peak lies against the plane of incidence
     /// (judged on the first channel's converted value, or luminance).
-    fn peak_azimuth(&self, (m, _, removed_by, directions): &Converted) -> Option<crate::align::PeakAzimuth> {
+    fn peak_azimuth(
+        &self,
+        (m, _, removed_by, directions): &Converted,
+    ) -> Option<crate::align::PeakAzimuth> {
         if self.patch_average.is_some() {
             return None;
         }

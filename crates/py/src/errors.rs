@@ -71,8 +71,8 @@ fn fit_set(e: brtf_fit::FitSetError) -> PyErr {
 }
 
 /// A `fit.json` that could not be read.
-pub(crate) fn read_fit(e: brtf_fit::ReadFitError, path: &std::path::Path) -> PyErr {
-    let file = Some(path.display().to_string());
+pub(crate) fn read_fit(e: brtf_fit::ReadFitError) -> PyErr {
+    let file = Some(e.path().display().to_string());
     let message = e.to_string();
     match &e {
         brtf_fit::ReadFitError::Io { error: io, .. } => error(io_class(io), message, file, None),
@@ -95,10 +95,7 @@ pub(crate) fn workflow(e: brtf_workflow::WorkflowError) -> PyErr {
         }
         WorkflowError::Read(e) => read(e),
         WorkflowError::FitSet(e) => fit_set(e),
-        WorkflowError::ReadFit(e) => {
-            let path = e.path().to_path_buf();
-            read_fit(e, &path)
-        }
+        WorkflowError::ReadFit(e) => read_fit(e),
         other => error("ExportError", other.to_string(), None, None),
     }
 }

@@ -131,9 +131,8 @@ impl Fit {
     #[staticmethod]
     fn load(py: Python<'_>, folder: PathBuf) -> PyResult<Fit> {
         let path = folder.join("fit.json");
-        let result = py
-            .detach(|| FitResult::read(&path))
-            .map_err(|e| errors::read_fit(e, &path))?;
+        let result = py.detach(|| FitResult::read(&path));
+        let result = result.map_err(errors::read_fit)?;
         let inputs = result.provenance.inputs.iter();
         let paths = inputs.map(|i| PathBuf::from(&i.path)).collect();
         Ok(Fit { result, paths })

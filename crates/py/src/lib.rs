@@ -23,7 +23,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
     name = None, variant = "radiance", fresnel_k = None, source_omega = 0.0,
     orientation = None, lobes = 1, floor = None, colour = "xyz", weights = "solid_angle",
     multistart = true, theta_cap = brtf_gonio::DEFAULT_THETA_CAP_DEG, beam_mask = 3.0,
-    hemisphere = None, min_value = None, mask_holder = false, beam_integral = None, rho = None,
+    hemisphere = None, min_value = None, mask_holder = false, phi_offset = None, beam_integral = None,
+    rho = None,
     free_scale = false, interpolation = "pchip", adequacy = true, side = None, incidences = None,
     patch_samples = 32, jobs = None))]
 #[allow(clippy::too_many_arguments)]
@@ -49,6 +50,7 @@ fn fit_set(
     hemisphere: Option<String>,
     min_value: Option<f64>,
     mask_holder: bool,
+    phi_offset: Option<String>,
     beam_integral: Option<f64>,
     rho: Option<(f64, f64)>,
     free_scale: bool,
@@ -83,6 +85,7 @@ fn fit_set(
         hemisphere: hemisphere.map(|h| word("hemisphere", &h)).transpose()?,
         min_value,
         mask_holder,
+        phi_offset: phi_offset.map(|v| word("phi_offset", &v)).transpose()?,
         beam_integral,
         rho: rho.map(|(rho, theta_in)| brtf_fit::KnownReflectance { rho, theta_in }),
         free_scale,
@@ -102,9 +105,7 @@ fn fit_set(
     if inputs.is_klems() != side.is_some() {
         return Err(errors::model(match side {
             Some(_) => "side= chooses the side of a Klems BSDF XML file",
-            None => {
-                "a Klems BSDF XML file is fitted one side at a time: side=\"front\" or \"back\""
-            }
+            None => "a Klems file is fitted one side at a time: side=\"front\" or \"back\"",
         }));
     }
     // Read and fitted on `jobs` threads, the GIL released; this thread

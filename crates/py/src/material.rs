@@ -4,9 +4,7 @@
 //! `--source-omega`, `--curved`).
 
 use crate::errors;
-use brtf_model::{
-    Composite, CompositeBsdf, EvalOptions, MaterialKind, Shape, WordError, direction,
-};
+use brtf_model::{Composite, CompositeBsdf, EvalOptions, MaterialKind, Shape, direction};
 use glam::DVec3;
 use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1};
 use pyo3::prelude::*;
@@ -71,7 +69,10 @@ pub(crate) fn parse_fresnel_k(value: &Bound<'_, PyAny>) -> PyResult<f64> {
 
 /// The keyword argument `what=value` read as one of a library enum's words
 /// (a `brtf.ModelError` listing them otherwise).
-pub(crate) fn word<T: std::str::FromStr<Err = WordError>>(what: &str, value: &str) -> PyResult<T> {
+pub(crate) fn word<T: std::str::FromStr<Err: std::fmt::Display>>(
+    what: &str,
+    value: &str,
+) -> PyResult<T> {
     value
         .parse::<T>()
         .map_err(|e| errors::model(format!("{what}={value:?}: {e}")))

@@ -4,8 +4,8 @@
 use crate::WorkflowError;
 use brtf_fit::klems::IncidenceFilter;
 use brtf_fit::{
-    AzimuthRule, ColourConversion, FitConfig, FitSetOptions, Interpolation, KnownReflectance, ModelChoice,
-    Recipe, ResidualKind, RobustLoss, ScaleRule, SelectionOptions, WeightRule,
+    AzimuthRule, ColourConversion, FitConfig, FitSetOptions, Interpolation, KnownReflectance,
+    ModelChoice, Recipe, ResidualKind, RobustLoss, ScaleRule, SelectionOptions, WeightRule,
 };
 use brtf_gonio::Hemispheres;
 use brtf_gonio::klems::Sides;
