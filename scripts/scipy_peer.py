@@ -13,7 +13,9 @@ With `--objective FILE SETTINGS` it fits any of brtf's objectives for a grey
 metal with a free scale (residual absolute, relative or log, with an
 optional Huber loss: scipy's own `loss="huber"`, `f_scale`; or, with
 `"lobes": 2`, the two-lobe metal `scale spec split1 rough1 rough2`, from
-several starts) to the samples in FILE (`vx,vy,vz,y,w`), and prints scipy's
+several starts; `"cosine_weighted": true` takes absolute residuals in a raw
+signal's own quantity, × |cos θ_out|, as brtf does) to the samples in FILE
+(`vx,vy,vz,y,w`), and prints scipy's
 cost at its own optimum and at brtf's parameters, as JSON. The CLI test
 `peer` uses it to check that brtf's cost is never above scipy's on the same
 objective.
@@ -140,13 +142,16 @@ def objective(path, settings):
     tan2 = (hh - hn * hn) / (hn * hn)
     norm = hh / (np.pi * hn ** 4)
     relative = sw / np.sqrt(y * y + floor * floor)
+    # brtf's absolute residuals are in the file's own quantity: for a raw
+    # signal or DSF, the BSDF residual times |cos θ_out|.
+    absolute = sw * (np.abs(views[:, 2]) if settings.get("cosine_weighted") else 1.0)
 
     lobes = settings.get("lobes", 1)
 
     def residuals(p):
         m = (two_lobe_model if lobes == 2 else lambda p, t, n: model(p, t, n)[0])(p, tan2, norm)
         if kind == "absolute":
-            return sw * (m - y)
+            return absolute * (m - y)
         if kind == "relative":
             return relative * (m - y)
         return sw * (np.log(m + floor) - np.log(np.maximum(y, 0.0) + floor))

@@ -99,6 +99,7 @@ fn brtf_is_never_above_scipy_on_the_same_objective() {
                 "floor": report.floor,
                 "residual": label,
                 "lobes": lobes,
+                "cosine_weighted": data.cosine_weighted,
                 "brtf": params,
             });
             if let RobustLoss::Huber(c) = loss {

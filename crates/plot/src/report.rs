@@ -410,7 +410,7 @@ fn provenance_section(out: &mut String, dir: &Path, result: &FitResult) {
             num(i.theta_in),
             num(i.phi_in),
             i.samples,
-            esc(&i.conversion.to_string()),
+            esc(&format!("{}{}", i.conversion, i.describe_turn())),
             esc(&i.sha256)
         );
     }

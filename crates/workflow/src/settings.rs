@@ -55,7 +55,8 @@ pub struct FitSettings {
     /// Mask the pgII holder's shadow.
     pub mask_holder: bool,
     /// How φ_out is aligned with the plane of incidence (`None`: the
-    /// peak aligned for gonio scans, the file's frame for Klems XML).
+    /// peak aligned for gonio scans fitted with an isotropic model or
+    /// `auto`; the file's frame for anisotropic models and Klems XML).
     pub phi_offset: Option<AzimuthRule>,
     /// Beam integral that makes raw-signal files absolute.
     pub beam_integral: Option<f64>,
@@ -195,7 +196,13 @@ impl FitSettings {
                 selections,
                 weights: self.weights,
                 patch_average: None,
-                azimuth: self.phi_offset.unwrap_or(AzimuthRule::AlignPeak),
+                // An anisotropic lobe turned in the plane can move the
+                // peak out of the plane of incidence itself.
+                azimuth: self.phi_offset.unwrap_or(if kind.is_anisotropic() && !auto {
+                    AzimuthRule::file_frame()
+                } else {
+                    AzimuthRule::AlignPeak
+                }),
             },
             known_reflectance: self.rho.map(|k| (k.rho, k.theta_in)),
             interpolation: self.interpolation,
