@@ -295,7 +295,7 @@ fn ggx_set_converges_everywhere_with_no_parameter_at_a_bound() {
     assert_eq!(csv.lines().count(), 7, "header, 5 incidences, all");
 }
 
-fn real_scan(name: &str) -> PathBuf {
+pub(crate) fn real_scan(name: &str) -> PathBuf {
     let path = repo_path("../shared/data/rgl-epfl-pgII-raw").join(name);
     assert!(
         path.exists(),

@@ -5,9 +5,10 @@
 //!   `lobes`: mixfunc lobe sums against it. Radiance is looked for in
 //!   `$RADIANCE_BIN`, on `PATH`, then in the repo's `.venv` (pyradiance);
 //!   without it the live tests warn and skip, except under `CI`.
-//! * `fit`, `recovery`, `many`, `peer`, `speed`: `brtf synth` + `brtf fit`
-//!   (known parameters back, real scans, sample folders, the scipy peer and
-//!   the data of the speed comparison).
+//! * `fit`, `recovery`, `align`, `many`, `peer`, `speed`: `brtf synth` +
+//!   `brtf fit` (known parameters back, scans turned back into their plane
+//!   of incidence, real scans, sample folders, the scipy peer and the data
+//!   of the speed comparison).
 //! * `contract`, `reproduce`, `safety`, `hostile`: what every command reads from a
 //!   fit folder, `fits/alu-ggx` rebuilt byte for byte, and no lost result
 //!   or unchecked option.
@@ -18,6 +19,7 @@
 //! * `common`: shared helpers.
 
 mod albedo;
+mod align;
 mod common;
 mod contract;
 mod eval;

@@ -198,11 +198,13 @@ impl FitSettings {
                 patch_average: None,
                 // An anisotropic lobe turned in the plane can move the
                 // peak out of the plane of incidence itself.
-                azimuth: self.phi_offset.unwrap_or(if kind.is_anisotropic() && !auto {
-                    AzimuthRule::file_frame()
-                } else {
-                    AzimuthRule::AlignPeak
-                }),
+                azimuth: self
+                    .phi_offset
+                    .unwrap_or(if kind.is_anisotropic() && !auto {
+                        AzimuthRule::file_frame()
+                    } else {
+                        AzimuthRule::AlignPeak
+                    }),
             },
             known_reflectance: self.rho.map(|k| (k.rho, k.theta_in)),
             interpolation: self.interpolation,
