@@ -12,6 +12,8 @@
 #    also the CPU time (user + sys of the process), which other load on
 #    the machine changes far less than the wall time. The summary also
 #    goes to target/bench-whole-process.txt.
+#    Each round also runs a two-lobe plastic (lean) and `--model auto`
+#    with every output.
 # 2. Unless --whole-only is given: the criterion benches of one fit on
 #    120 000 synthetic points, then `vs_scipy`, which alternates brtf fits
 #    (two threads and one) with scipy fits and prints the best times, the
@@ -45,12 +47,17 @@ brtf = "target/release/brtf"
 common = [brtf, "fit", golden, "--model", "metal", "--gray", "--force"]
 lean = common + ["--no-plots", "--no-export", "--out", f"{work}/lean"]
 full = common + ["--out", f"{work}/full"]
+# The lobe sums of --model auto, in the same rounds: a two-lobe plastic
+# lean, and auto with every output.
+two_lobes = [brtf, "fit", golden, "--model", "plastic", "--lobes", "2", "--force",
+             "--no-plots", "--no-export", "--out", f"{work}/two"]
+auto = [brtf, "fit", golden, "--model", "auto", "--force", "--out", f"{work}/auto"]
 peer = subprocess.Popen([sys.executable, "scripts/scipy_peer.py", "--serve", "target/golden-peer.csv"],
                         stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
 assert peer.stdout.readline().strip() == "ready"
 
 
-cpu = {"lean": [], "full": []}
+cpu = {"lean": [], "full": [], "two": [], "auto": []}
 PAUSE = 0.5  # seconds
 
 
@@ -64,10 +71,12 @@ def run(key, command):
     return wall
 
 
-times = {"lean": [], "full": [], "scipy": []}
+times = {"lean": [], "full": [], "two": [], "auto": [], "scipy": []}
 for _ in range(rounds):
     times["lean"].append(run("lean", lean))
     times["full"].append(run("full", full))
+    times["two"].append(run("two", two_lobes))
+    times["auto"].append(run("auto", auto))
     peer.stdin.write("fit\n")
     peer.stdin.flush()
     times["scipy"].append(float(peer.stdout.readline().split()[0]) / 1e3)
@@ -82,6 +91,7 @@ load = os.getloadavg()[0]
 print(f"whole process on golden_paper.txt (127 039 rows), {rounds} rounds, "
       f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, load {load:.2f}, {os.cpu_count()} cores")
 for key, label in [("lean", "brtf fit --no-plots --no-export"), ("full", "brtf fit (all outputs)"),
+                   ("two", "--lobes 2, --no-plots --no-export"), ("auto", "--model auto (all outputs)"),
                    ("scipy", "scipy least_squares alone")]:
     v = sorted(times[key])
     line = f"  {label:34s} median {1e3 * med[key]:8.1f} ms  (min {1e3 * v[0]:.1f}, max {1e3 * v[-1]:.1f})"
