@@ -121,6 +121,9 @@ def test_fit_equals_brtf_fit_on_alu_ggx(cli, tmp_path, alu):
     [
         ({"gray": True}, ["--gray"]),
         ({"gray": True, "residual": "relative", "loss": "huber"}, ["--gray", "--residual", "relative", "--loss", "huber"]),
+        # The file's frame, and a turn given in degrees, as on the command line.
+        ({"gray": True, "phi_offset": 0}, ["--gray", "--phi-offset", "0"]),
+        ({"gray": True, "phi_offset": -2.5}, ["--gray", "--phi-offset", "-2.5"]),
     ],
 )
 def test_fit_equals_brtf_fit_on_golden_paper(cli, tmp_path, golden_paper, options, flags):
@@ -134,6 +137,8 @@ def test_fit_equals_brtf_fit_on_golden_paper(cli, tmp_path, golden_paper, option
     py_inc, cli_inc = fit.incidences[0], cli_json["incidences"][0]
     assert py_inc.n_points == cli_inc["n_points"]
     assert py_inc.termination == brtf.Fit.load(out).incidences[0].termination
+    turn = cli_json["provenance"]["inputs"][0].get("phi_turn_deg", 0.0)
+    assert turn == options.get("phi_offset", pytest.approx(3.4356, abs=1e-3))
     for p in cli_inc["params"]:
         if p["stderr"] is not None:
             assert py_inc.stderr[p["name"]] == pytest.approx(p["stderr"], rel=1e-6)

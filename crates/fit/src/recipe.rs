@@ -452,12 +452,16 @@ impl Recipe {
             AzimuthRule::Turn { degrees } => degrees,
         };
         if turn != 0.0 {
-            // A turn about the normal keeps every cell's solid angle.
-            let mut turned = measurement;
-            for sample in &mut turned.samples {
+            // A turn about the normal keeps every cell's solid angle and
+            // every converted value (they depend on θ_out only): only the
+            // directions and the gates are made again.
+            let (turned, conversion, _, _) = converted;
+            let mut turned = turned;
+            turned.samples.par_iter_mut().with_min_len(SAMPLE_PIECE).for_each(|sample| {
                 sample.phi_deg = (sample.phi_deg + turn).rem_euclid(360.0);
-            }
-            converted = self.convert_and_gate(&turned, source)?;
+            });
+            let (removed_by, directions) = self.gate(&turned);
+            converted = (turned, conversion, removed_by, directions);
         }
         let (mut measurement, conversion, removed_by, directions) = converted;
         // The conversions keep the samples and their order.
@@ -542,10 +546,16 @@ impl Recipe {
         } else {
             self.convert(measurement, source)?
         };
-        // Each sample is removed by the first gate it fails, if any. The
-        // conversion keeps the angles, so the directions are the same.
-        let context = GateContext::of(&measurement);
-        let (removed_by, directions) = measurement
+        // The conversion keeps the angles, so the directions are the same.
+        let (removed_by, directions) = self.gate(&measurement);
+        Ok((measurement, conversion, removed_by, directions))
+    }
+
+    /// Per sample of the converted `measurement` the first gate it fails,
+    /// if any, and every sample's direction.
+    fn gate(&self, measurement: &Measurement) -> (Vec<Option<usize>>, Vec<DVec3>) {
+        let context = GateContext::of(measurement);
+        measurement
             .samples
             .par_iter()
             .with_min_len(SAMPLE_PIECE)
@@ -557,8 +567,7 @@ impl Recipe {
                     .position(|gate| !gate.keeps_at(sample, || direction, &context));
                 (removed, direction)
             })
-            .unzip();
-        Ok((measurement, conversion, removed_by, directions))
+            .unzip()
     }
 
     /// Step 3: the fitted quantity.
