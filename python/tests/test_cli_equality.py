@@ -162,7 +162,7 @@ def test_save_writes_the_folder_brtf_fit_writes(cli, tmp_path, alu):
     for name in ("alu-ggx.rad", "alu-ggx-theta.rad", "alu-ggx-theta.cal"):
         assert body(tmp_path / "py" / name) == body(tmp_path / "cli" / name)
     # The rest is the same bytes: params.csv, every plot, the preview scene.
-    same = [f for f in cli_files if f.startswith("plots/") or f in ("params.csv", "alu-ggx-preview.rad")]
+    same = [f for f in cli_files if f.startswith("plots/") or f in ("params.csv", "residuals.csv", "alu-ggx-preview.rad")]
     assert len(same) > 20
     for name in same:
         assert (tmp_path / "py" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes(), name

@@ -671,14 +671,19 @@ fn adequacy_separates_a_good_fit_from_inadequate_ones() {
         &[real_scan("layer_020_030.txt")],
         &["--model", "plastic", "--gray", "--no-export", "--no-plots"],
     );
+    // One lobe trades the layered sample's sharp core against its broad
+    // sheen: the specularity doubles with log residuals, and E1 stays high.
     let r = &layer.incidences[0];
     assert!(
-        r.warnings
-            .iter()
-            .any(|w| matches!(w, brtf_fit::FitWarning::PeakOffset { degrees } if *degrees > 10.0)),
+        r.warnings.iter().any(|w| matches!(
+            w,
+            brtf_fit::FitWarning::ResidualKindSensitive { check }
+                if check.param == "spec" && check.relative_change > 0.3
+        )),
         "{:?}",
         r.warnings
     );
+    assert!(r.e1.unwrap() > 0.12, "E1 {:?}", r.e1);
 }
 
 /// Multi-start never ends above any of its candidates or above a single

@@ -14,7 +14,8 @@
 //!   or unchecked option.
 //! * `export`, `klems_export`, `klems_fit`: Radiance and Klems exports, and
 //!   Klems XML in.
-//! * `render`, `lobe_render`, `plot`: the tracer, `brtf check` and the plots.
+//! * `render`, `lobe_render`, `plot`, `residuals`: the tracer, `brtf
+//!   check`, the plots and `residuals.csv`.
 //! * `layout`: the source tree's shape (no import circles, thin front ends).
 //! * `common`: shared helpers.
 
@@ -38,6 +39,7 @@ mod plot;
 mod recovery;
 mod render;
 mod reproduce;
+mod residuals;
 mod rtrace;
 mod safety;
 mod speed;

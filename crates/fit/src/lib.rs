@@ -46,6 +46,7 @@ mod prepare;
 mod problem;
 mod recipe;
 mod report;
+mod residuals;
 mod result;
 mod robust;
 mod serde_kind;
@@ -76,6 +77,7 @@ pub use recipe::{
 pub use report::{
     FitReport, FitWarning, ParamEstimate, RobustRecord, StartRecord, StderrRatio, Termination,
 };
+pub use residuals::{residual_rows, residuals_header};
 pub use result::{FIT_JSON_SCHEMA, FitResult, InputFile, Provenance, ReadFitError, SetWarning};
 pub use set::{
     FitSetError, FitSetOptions, FittedSet, KlemsOptions, NoProgress, Progress, fit_set,

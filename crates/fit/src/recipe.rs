@@ -457,9 +457,13 @@ impl Recipe {
             // directions and the gates are made again.
             let (turned, conversion, _, _) = converted;
             let mut turned = turned;
-            turned.samples.par_iter_mut().with_min_len(SAMPLE_PIECE).for_each(|sample| {
-                sample.phi_deg = (sample.phi_deg + turn).rem_euclid(360.0);
-            });
+            turned
+                .samples
+                .par_iter_mut()
+                .with_min_len(SAMPLE_PIECE)
+                .for_each(|sample| {
+                    sample.phi_deg = (sample.phi_deg + turn).rem_euclid(360.0);
+                });
             let (removed_by, directions) = self.gate(&turned);
             converted = (turned, conversion, removed_by, directions);
         }

@@ -89,6 +89,18 @@ impl GateContext {
 }
 
 impl Gate {
+    /// The gate's name in `fit.json` (its `gate` tag), for tables.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Gate::Unavailable => "unavailable",
+            Gate::Hemisphere { .. } => "hemisphere",
+            Gate::ThetaCap { .. } => "theta_cap",
+            Gate::BeamMask { .. } => "beam_mask",
+            Gate::MinValue { .. } => "min_value",
+            Gate::AzimuthBand { .. } => "azimuth_band",
+        }
+    }
+
     /// Checks a gate's number, named by its `brtf fit` option:
     /// `--theta-cap` in (0, 90], `--beam-mask` in [0, 90), `--min-value`
     /// finite.

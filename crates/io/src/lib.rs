@@ -129,6 +129,11 @@ pub fn ensure_folder(dir: &Path) -> Result<(), IoError> {
 /// rename. The folder must exist ([`ensure_folder`]). On failure the
 /// temporary file is removed and `path` is untouched.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), IoError> {
+    write_atomic_parts(path, &[bytes])
+}
+
+/// [`write_atomic`] of the concatenation of `parts`, without making it.
+pub fn write_atomic_parts(path: &Path, parts: &[&[u8]]) -> Result<(), IoError> {
     let fail = |what: &'static str, at: &Path| {
         let at = at.to_path_buf();
         move |source| IoError {
@@ -146,7 +151,9 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), IoError> {
         .suffix(".tmp")
         .tempfile_in(dir)
         .map_err(fail("cannot write", path))?;
-    tmp.write_all(bytes).map_err(fail("cannot write", path))?;
+    for part in parts {
+        tmp.write_all(part).map_err(fail("cannot write", path))?;
+    }
     tmp.as_file()
         .sync_all()
         .map_err(fail("cannot write", path))?;

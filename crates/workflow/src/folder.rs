@@ -1,4 +1,4 @@
-//! A fit folder, written whole: `params.csv`, the Radiance exports, the
+//! A fit folder, written whole: `params.csv`, `residuals.csv`, the Radiance exports, the
 //! plots and `report.html`, then `fit.json` listing every file, staged
 //! and swapped in as one ([`brtf_io::FolderUpdate`]).
 
@@ -52,7 +52,7 @@ impl std::fmt::Display for FolderWritten {
 }
 
 /// Writes one fit's folder into `stage` (shown to the user as `shown`):
-/// `params.csv`, the exports and plots `outputs` asks for, then
+/// `params.csv`, `residuals.csv`, the exports and plots `outputs` asks for, then
 /// `fit.json` listing them. The plots draw `prepared` (the fitted data,
 /// as [`brtf_fit::fit_set_with_data`] keeps them) and read the
 /// measurement files for incidences it lacks.
@@ -63,9 +63,39 @@ pub fn write_fit_folder(
     prepared: &[PreparedMeasurement],
     outputs: Outputs,
 ) -> Result<FolderWritten, WorkflowError> {
-    // fit.json is written once, last: it lists every other file.
+    // fit.json is written once, last: it lists every other file. The
+    // residuals (megabytes of text) are written beside the exports and
+    // plots.
     result.write_params_csv(stage)?;
-    let mut listed = describe_outputs(stage, &[stage.join("params.csv")], Producer::Fit)?;
+    let shared: &FitResult = result;
+    let (residuals, rest) = rayon::join(
+        || crate::residuals::write_residuals(stage, shown, shared, prepared),
+        || exports_and_plots(stage, shown, shared, prepared, outputs),
+    );
+    let (residuals, notes) = residuals?;
+    let (mut written, exported) = rest?;
+    let mut listed =
+        describe_outputs(stage, &[stage.join("params.csv"), residuals], Producer::Fit)?;
+    listed.extend(exported);
+    written
+        .notes
+        .splice(0..0, notes.iter().map(|n| format!("note: {n}")));
+    listed.sort_by(|a, b| a.path.cmp(&b.path));
+    result.outputs = listed;
+    result.write_fit_json(stage)?;
+    Ok(written)
+}
+
+/// The exports and plots `outputs` asks for, written into `stage`: what
+/// the user is told, and the files' listing.
+fn exports_and_plots(
+    stage: &Path,
+    shown: &Path,
+    result: &FitResult,
+    prepared: &[PreparedMeasurement],
+    outputs: Outputs,
+) -> Result<(FolderWritten, Vec<OutputFile>), WorkflowError> {
+    let mut listed = Vec::new();
     let mut written = FolderWritten::default();
     if outputs.export {
         let options = brtf_radiance::export::ExportOptions::default();
@@ -101,10 +131,7 @@ pub fn write_fit_folder(
                 .map(|w| format!("brtf: warning: {w}")),
         );
     }
-    listed.sort_by(|a, b| a.path.cmp(&b.path));
-    result.outputs = listed;
-    result.write_fit_json(stage)?;
-    Ok(written)
+    Ok((written, listed))
 }
 
 /// `files` (under `stage`) as the user will find them (under `shown`).

@@ -27,6 +27,7 @@ mod inputs;
 mod jobs;
 mod material;
 mod render;
+mod residuals;
 mod run;
 mod settings;
 

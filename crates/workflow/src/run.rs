@@ -154,12 +154,7 @@ pub fn fit_to_folder(
             _ => (update.path().to_path_buf(), out.clone()),
         };
         brtf_io::ensure_folder(&folder)?;
-        // Only the plots draw the fitted data.
-        let prepared = if request.outputs.plots {
-            prepared
-        } else {
-            Vec::new()
-        };
+        // The residuals and the plots draw the fitted data.
         let written: FolderWritten =
             write_fit_folder(&folder, &shown, &mut result, &prepared, request.outputs)?;
         drop(prepared);
