@@ -58,6 +58,8 @@ def fit(inputs, model="metal", **options) -> Fit:
     orientation = options.get("orientation")
     if orientation is not None and all(c == 0 for c in orientation):
         raise ModelError("orientation needs three numbers x, y, z, not all zero")
+    if isinstance(options.get("mask_holder"), bool):
+        options["mask_holder"] = "band" if options["mask_holder"] else None
     if options.get("phi_offset") is not None:
         options["phi_offset"] = str(options["phi_offset"])
     return _brtf.fit(paths, model, **options)

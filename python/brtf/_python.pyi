@@ -27,7 +27,7 @@ def fit(
     beam_mask: float = 3.0,
     hemisphere: Optional[Literal["front", "back", "both"]] = None,
     min_value: Optional[float] = None,
-    mask_holder: bool = False,
+    mask_holder: Union[bool, Literal["band", "auto"]] = False,
     phi_offset: Optional[Union[float, Literal["auto"]]] = None,
     beam_integral: Optional[float] = None,
     rho: Optional[tuple[float, float]] = None,

@@ -124,6 +124,9 @@ def test_fit_equals_brtf_fit_on_alu_ggx(cli, tmp_path, alu):
         # The file's frame, and a turn given in degrees, as on the command line.
         ({"gray": True, "phi_offset": 0}, ["--gray", "--phi-offset", "0"]),
         ({"gray": True, "phi_offset": -2.5}, ["--gray", "--phi-offset", "-2.5"]),
+        # The holder's shadow: its band (True) and the shadows found.
+        ({"gray": True, "mask_holder": True}, ["--gray", "--mask-holder"]),
+        ({"gray": True, "mask_holder": "auto"}, ["--gray", "--mask-holder", "auto"]),
     ],
 )
 def test_fit_equals_brtf_fit_on_golden_paper(cli, tmp_path, golden_paper, options, flags):

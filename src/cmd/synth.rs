@@ -61,6 +61,9 @@ pub(crate) struct SynthArgs {
     /// No holder-shadow gap.
     #[arg(long)]
     pub no_holder_gap: bool,
+    /// Darken the holder's shadow 100× (φ_out − φ_in 270 ± 45° at θ_out ≥ 73.5°).
+    #[arg(long)]
+    pub holder_shadow: bool,
     /// No noise-only back rows for opaque samples.
     #[arg(long)]
     pub no_back_rows: bool,
@@ -117,6 +120,7 @@ pub(crate) fn run(args: SynthArgs) -> Result<()> {
             noise_floor: args.noise_floor,
             blind_spot_deg: args.blind_spot,
             holder_gap: !args.no_holder_gap,
+            holder_shadow: args.holder_shadow,
             back_rows: !args.no_back_rows,
             aperture_rays: 3,
         },

@@ -385,7 +385,7 @@ fn free_scale_plastic_export_and_the_holder_mask() {
     assert!(masked.removed > 1000, "{masked:?}");
     let report = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert!(report.contains(&format!(
-        "holder band φ_out 270±15° at θ_out &gt;= 70° (−{})",
+        "holder band φ_out − φ_in 270±45° at θ_out &gt;= 73° (−{})",
         masked.removed
     )));
     let rad = std::fs::read_dir(&out)

@@ -168,6 +168,7 @@ fn result_of(
                     klems: None,
                     phi_turn_deg: 0.0,
                     peak_arc_deg: None,
+                    shadows: Vec::new(),
                 })
                 .collect(),
         },

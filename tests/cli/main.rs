@@ -5,10 +5,11 @@
 //!   `lobes`: mixfunc lobe sums against it. Radiance is looked for in
 //!   `$RADIANCE_BIN`, on `PATH`, then in the repo's `.venv` (pyradiance);
 //!   without it the live tests warn and skip, except under `CI`.
-//! * `fit`, `recovery`, `align`, `many`, `peer`, `speed`: `brtf synth` +
-//!   `brtf fit` (known parameters back, scans turned back into their plane
-//!   of incidence, real scans, sample folders, the scipy peer and the data
-//!   of the speed comparison).
+//! * `fit`, `recovery`, `align`, `shadow`, `many`, `peer`, `speed`: `brtf
+//!   synth` + `brtf fit` (known parameters back, scans turned back into
+//!   their plane of incidence, the holder's shadow found and masked, real
+//!   scans, sample folders, the scipy peer and the data of the speed
+//!   comparison).
 //! * `contract`, `reproduce`, `safety`, `hostile`: what every command reads from a
 //!   fit folder, `fits/alu-ggx` rebuilt byte for byte, and no lost result
 //!   or unchecked option.
@@ -42,4 +43,5 @@ mod reproduce;
 mod residuals;
 mod rtrace;
 mod safety;
+mod shadow;
 mod speed;

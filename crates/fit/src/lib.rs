@@ -71,8 +71,8 @@ pub use fitter::{fit_global, fit_incidence};
 pub use params::{MAX_ROUGHNESS, MIN_ROUGHNESS, ParamMap, Slot, Target};
 pub use problem::ResidualKind;
 pub use recipe::{
-    BeamOrigin, ColourConversion, Conversion, DataUnit, PatchAveraging, PreparedMeasurement,
-    RawScale, Recipe, RecipeError, ScaleRule, SelectionOptions, WeightRule,
+    BeamOrigin, ColourConversion, Conversion, DataUnit, HolderMask, PatchAveraging,
+    PreparedMeasurement, RawScale, Recipe, RecipeError, ScaleRule, SelectionOptions, WeightRule,
 };
 pub use report::{
     FitReport, FitWarning, ParamEstimate, RobustRecord, StartRecord, StderrRatio, Termination,

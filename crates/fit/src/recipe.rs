@@ -21,6 +21,7 @@
 
 use crate::align::{AzimuthRule, aligning_turn, peak_azimuth};
 use crate::data::{FitSample, GateCount, IncidenceData, Weighting};
+use brtf_gonio::shadow::ShadowRegion;
 use brtf_gonio::{Gate, GateContext, Measurement, Quantity, SolidAngleSource};
 use glam::DVec3;
 use rayon::prelude::*;
@@ -207,9 +208,21 @@ pub struct SelectionOptions {
     pub beam_mask: f64,
     /// Drop samples below this value.
     pub min_value: Option<f64>,
-    /// Mask the pgII sample holder's shadow.
-    pub mask_holder: bool,
+    /// Mask the pgII sample holder's shadow: its fixed band, or the
+    /// shadows found in each scan.
+    pub mask_holder: Option<HolderMask>,
 }
+
+/// How `--mask-holder` finds the holder's shadow.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HolderMask {
+    /// The fixed band in the instrument's frame ([`brtf_gonio::PGII_HOLDER_BAND`]).
+    Band,
+    /// The shadows found in each scan ([`brtf_gonio::DETECTED_SHADOW`]).
+    Auto,
+}
+
+brtf_model::option_words!(HolderMask { Band => "band", Auto => "auto" });
 
 impl SelectionOptions {
     /// The default hemisphere for `kind`: the front for opaque models,
@@ -235,8 +248,10 @@ impl SelectionOptions {
             }
         }
         selections.extend(self.min_value.map(|min| Gate::MinValue { min }));
-        if self.mask_holder {
-            selections.push(brtf_gonio::PGII_HOLDER_BAND);
+        match self.mask_holder {
+            Some(HolderMask::Band) => selections.push(brtf_gonio::PGII_HOLDER_BAND),
+            Some(HolderMask::Auto) => selections.push(brtf_gonio::DETECTED_SHADOW),
+            None => {}
         }
         selections
     }
@@ -425,11 +440,20 @@ pub struct PreparedMeasurement {
     /// How far (degrees of arc) the data's peak lay from the plane of
     /// incidence before the turn; `None` without a distinct peak.
     pub peak_arc_deg: Option<f64>,
+    /// The shadows a [`Gate::Shadow`] found (`--mask-holder auto`).
+    pub shadows: Vec<ShadowRegion>,
 }
 
 /// What [`Recipe::convert_and_gate`] makes: the converted measurement,
-/// per sample the gate that removed it, and every sample's direction.
-type Converted = (Measurement, Conversion, Vec<Option<usize>>, Vec<DVec3>);
+/// per sample the gate that removed it, every sample's direction, and the
+/// shadows a [`Gate::Shadow`] found.
+type Converted = (
+    Measurement,
+    Conversion,
+    Vec<Option<usize>>,
+    Vec<DVec3>,
+    Vec<ShadowRegion>,
+);
 
 impl Recipe {
     /// Applies the recipe to `measurement`, read from `source`.
@@ -455,7 +479,7 @@ impl Recipe {
             // A turn about the normal keeps every cell's solid angle and
             // every converted value (they depend on θ_out only): only the
             // directions and the gates are made again.
-            let (turned, conversion, _, _) = converted;
+            let (turned, conversion, _, _, _) = converted;
             let mut turned = turned;
             turned
                 .samples
@@ -464,10 +488,10 @@ impl Recipe {
                 .for_each(|sample| {
                     sample.phi_deg = (sample.phi_deg + turn).rem_euclid(360.0);
                 });
-            let (removed_by, directions) = self.gate(&turned);
-            converted = (turned, conversion, removed_by, directions);
+            let (removed_by, directions, shadows) = self.gate(&turned);
+            converted = (turned, conversion, removed_by, directions, shadows);
         }
-        let (mut measurement, conversion, removed_by, directions) = converted;
+        let (mut measurement, conversion, removed_by, directions, shadows) = converted;
         // The conversions keep the samples and their order.
         measurement.set_solid_angles(&solid_angles);
         let weighting = match (self.weights, solid_angles.source) {
@@ -499,6 +523,7 @@ impl Recipe {
             directions,
             phi_turn_deg: turn,
             peak_arc_deg: peak.map(|p| p.arc_deg),
+            shadows,
         })
     }
 
@@ -506,7 +531,7 @@ impl Recipe {
     /// (judged on the first channel's converted value, or luminance).
     fn peak_azimuth(
         &self,
-        (m, _, removed_by, directions): &Converted,
+        (m, _, removed_by, directions, _): &Converted,
     ) -> Option<crate::align::PeakAzimuth> {
         if self.patch_average.is_some() {
             return None;
@@ -551,15 +576,20 @@ impl Recipe {
             self.convert(measurement, source)?
         };
         // The conversion keeps the angles, so the directions are the same.
-        let (removed_by, directions) = self.gate(&measurement);
-        Ok((measurement, conversion, removed_by, directions))
+        let (removed_by, directions, shadows) = self.gate(&measurement);
+        Ok((measurement, conversion, removed_by, directions, shadows))
     }
 
     /// Per sample of the converted `measurement` the first gate it fails,
-    /// if any, and every sample's direction.
-    fn gate(&self, measurement: &Measurement) -> (Vec<Option<usize>>, Vec<DVec3>) {
+    /// if any, every sample's direction, and the shadows a
+    /// [`Gate::Shadow`] found (it judges the samples the gates before it
+    /// kept, all at once).
+    fn gate(
+        &self,
+        measurement: &Measurement,
+    ) -> (Vec<Option<usize>>, Vec<DVec3>, Vec<ShadowRegion>) {
         let context = GateContext::of(measurement);
-        measurement
+        let (mut removed_by, directions): (Vec<Option<usize>>, Vec<DVec3>) = measurement
             .samples
             .par_iter()
             .with_min_len(SAMPLE_PIECE)
@@ -571,7 +601,48 @@ impl Recipe {
                     .position(|gate| !gate.keeps_at(sample, || direction, &context));
                 (removed, direction)
             })
-            .unzip()
+            .unzip();
+        let shadow = self
+            .selections
+            .iter()
+            .enumerate()
+            .find_map(|(g, gate)| match *gate {
+                Gate::Shadow {
+                    max_ratio,
+                    min_theta_deg,
+                } => Some((g, max_ratio, min_theta_deg)),
+                _ => None,
+            });
+        let Some((g, max_ratio, min_theta_deg)) = shadow else {
+            return (removed_by, directions, Vec::new());
+        };
+        let channels = measurement.channels.count();
+        let values: Vec<f64> = measurement
+            .samples
+            .iter()
+            .map(|s| {
+                if channels == 3 {
+                    brtf_model::luminance(s.values)
+                } else {
+                    s.values[0]
+                }
+            })
+            .collect();
+        let candidates: Vec<bool> = removed_by.iter().map(Option::is_none).collect();
+        let found = brtf_gonio::shadow::detect(
+            &directions,
+            &values,
+            &candidates,
+            measurement.incidence.phi_deg,
+            max_ratio,
+            min_theta_deg,
+        );
+        for (removed, flagged) in removed_by.iter_mut().zip(&found.flagged) {
+            if *flagged {
+                *removed = Some(g);
+            }
+        }
+        (removed_by, directions, found.regions)
     }
 
     /// Step 3: the fitted quantity.

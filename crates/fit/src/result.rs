@@ -44,6 +44,9 @@ pub struct InputFile {
     /// incidence before any turn; `None` without a distinct peak.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub peak_arc_deg: Option<f64>,
+    /// The shadows `--mask-holder auto` found and masked.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub shadows: Vec<brtf_gonio::shadow::ShadowRegion>,
 }
 
 fn is_zero(x: &f64) -> bool {

@@ -380,6 +380,7 @@ fn read_input(
                 klems: at,
                 phi_turn_deg: prepared.phi_turn_deg,
                 peak_arc_deg: prepared.peak_arc_deg,
+                shadows: prepared.shadows.clone(),
             },
             prepared,
         }

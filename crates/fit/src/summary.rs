@@ -32,6 +32,9 @@ pub fn summary(result: &FitResult, out: &Path) -> String {
                 i.conversion,
                 i.describe_turn()
             );
+            for shadow in &i.shadows {
+                let _ = writeln!(s, "    shadow masked: {shadow}");
+            }
         }
     }
     let names: Vec<&str> = result

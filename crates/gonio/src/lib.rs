@@ -47,6 +47,7 @@ pub mod klems;
 mod measurement;
 mod read;
 mod select;
+pub mod shadow;
 mod solid_angle;
 mod summary;
 pub mod synth;
@@ -65,7 +66,9 @@ pub use read::{
     detect_format, incidence_from_file_name, is_xml, read_bytes, read_bytes_as, read_path,
     read_path_as, read_sample_name, read_sample_name_at, read_str,
 };
-pub use select::{DEFAULT_THETA_CAP_DEG, Gate, GateContext, PGII_HOLDER_BAND, Selection};
+pub use select::{
+    DEFAULT_THETA_CAP_DEG, DETECTED_SHADOW, Gate, GateContext, PGII_HOLDER_BAND, Selection,
+};
 pub use solid_angle::{
     DISK_RADIUS, DirectionLayout, SolidAngleSource, SolidAngles, compute_solid_angles,
     detect_layout, disk_voronoi_areas, project, reference_disk_voronoi_areas, solid_angles,

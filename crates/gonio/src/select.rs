@@ -49,7 +49,9 @@ pub enum Gate {
     },
     /// Drops a band of azimuths at grazing angles, where a sample holder
     /// shadows the detector: |φ_out − `center_deg`| ≤ `half_width_deg` and
-    /// θ_out (from the nearer normal) ≥ `min_theta_deg`.
+    /// θ_out (from the nearer normal) ≥ `min_theta_deg`; with
+    /// `from_incidence` the centre is measured from φ_in (the instrument's
+    /// frame, in which the holder stays put while the sample turns).
     AzimuthBand {
         /// Centre azimuth, degrees.
         center_deg: f64,
@@ -57,16 +59,39 @@ pub enum Gate {
         half_width_deg: f64,
         /// Smallest θ_out dropped, degrees.
         min_theta_deg: f64,
+        /// The centre is φ_in + `center_deg` (fits saved before the field
+        /// had an absolute centre).
+        #[serde(default)]
+        from_incidence: bool,
+    },
+    /// Drops the samples of connected regions that read far below their
+    /// mirror across the plane of incidence (a shadow, such as the
+    /// holder's): see [`crate::shadow`]. Decided over all samples at once
+    /// by [`crate::shadow::detect`], not sample by sample.
+    Shadow {
+        /// A region's median ratio to its mirror must be below this.
+        max_ratio: f64,
+        /// Only samples at least this far from the nearer normal, degrees.
+        min_theta_deg: f64,
     },
 }
 
-/// The pgII holder's shadow (`brtf fit --mask-holder`): φ_out 270 ± 15°
-/// at θ_out ≥ 70°, where the real pgII scans read 2-2.5× below the
-/// opposite azimuth.
+/// The pgII holder's shadow (`brtf fit --mask-holder`): φ_out − φ_in in
+/// 270 ± 45° at θ_out ≥ 73°, where both real pgII scans read 5× (glossy
+/// paper) to 300× (layered sample) below their mirror azimuth, from
+/// θ_out 73.5° on.
 pub const PGII_HOLDER_BAND: Gate = Gate::AzimuthBand {
     center_deg: 270.0,
-    half_width_deg: 15.0,
-    min_theta_deg: 70.0,
+    half_width_deg: 45.0,
+    min_theta_deg: 73.0,
+    from_incidence: true,
+};
+
+/// `brtf fit --mask-holder auto`: regions at θ_out ≥ 60° whose median
+/// is below half their mirror's.
+pub const DETECTED_SHADOW: Gate = Gate::Shadow {
+    max_ratio: 0.5,
+    min_theta_deg: 60.0,
 };
 
 /// What a gate needs to know about the measurement it filters.
@@ -76,6 +101,8 @@ pub struct GateContext {
     channels: usize,
     /// Towards the light.
     light: DVec3,
+    /// φ_in, degrees.
+    phi_in: f64,
 }
 
 impl GateContext {
@@ -84,6 +111,7 @@ impl GateContext {
         GateContext {
             channels: measurement.channels.count(),
             light: measurement.incident_direction(),
+            phi_in: measurement.incidence.phi_deg,
         }
     }
 }
@@ -98,6 +126,7 @@ impl Gate {
             Gate::BeamMask { .. } => "beam_mask",
             Gate::MinValue { .. } => "min_value",
             Gate::AzimuthBand { .. } => "azimuth_band",
+            Gate::Shadow { .. } => "shadow",
         }
     }
 
@@ -123,10 +152,20 @@ impl Gate {
             Gate::MinValue { min } => {
                 OptionError::check("--min-value", min, min.is_finite(), "a finite number")
             }
+            Gate::Shadow {
+                max_ratio,
+                min_theta_deg,
+            } => OptionError::check(
+                "--mask-holder",
+                max_ratio,
+                max_ratio > 0.0 && max_ratio < 1.0 && (0.0..90.0).contains(&min_theta_deg),
+                "a ratio in (0, 1) and 0 ≤ θ < 90 degrees",
+            ),
             Gate::AzimuthBand {
                 center_deg,
                 half_width_deg,
                 min_theta_deg,
+                ..
             } => OptionError::check(
                 "--mask-band",
                 half_width_deg,
@@ -167,12 +206,20 @@ impl Gate {
                 direction().dot(context.light) < brtf_model::cos_degrees(half_angle_deg)
             }
             Gate::MinValue { min } => values.iter().all(|&v| v.is_finite() && v >= min),
+            // Decided for all samples at once (`crate::shadow::detect`).
+            Gate::Shadow { .. } => true,
             Gate::AzimuthBand {
                 center_deg,
                 half_width_deg,
                 min_theta_deg,
+                from_incidence,
             } => {
-                let dphi = sample.phi_deg - center_deg;
+                let center = if from_incidence {
+                    context.phi_in + center_deg
+                } else {
+                    center_deg
+                };
+                let dphi = sample.phi_deg - center;
                 // rem_euclid is a slow fmod; in range it is the identity.
                 let dphi = if (0.0..360.0).contains(&dphi) {
                     dphi
@@ -204,9 +251,26 @@ impl std::fmt::Display for Gate {
                 center_deg,
                 half_width_deg,
                 min_theta_deg,
+                from_incidence: false,
             } => write!(
                 f,
                 "holder band φ_out {center_deg}±{half_width_deg}° at θ_out >= {min_theta_deg}°"
+            ),
+            Gate::AzimuthBand {
+                center_deg,
+                half_width_deg,
+                min_theta_deg,
+                from_incidence: true,
+            } => write!(
+                f,
+                "holder band φ_out − φ_in {center_deg}±{half_width_deg}° at θ_out >= {min_theta_deg}°"
+            ),
+            Gate::Shadow {
+                max_ratio,
+                min_theta_deg,
+            } => write!(
+                f,
+                "shadows below {max_ratio}× their mirror at θ_out >= {min_theta_deg}°"
             ),
         }
     }

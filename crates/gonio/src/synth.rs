@@ -147,6 +147,10 @@ pub struct Instrument {
     /// Remove a holder-shadow gap: near-grazing directions (θ > 80°)
     /// within ±10° of φ_in + 90°, where the sample holder's arm stands.
     pub holder_gap: bool,
+    /// Darken the pgII holder's shadow 100×: φ_out − φ_in in 270 ± 45° at
+    /// θ_out ≥ 73.5°, where the real pgII scans read far below their
+    /// mirror azimuth ([`crate::PGII_HOLDER_BAND`]).
+    pub holder_shadow: bool,
     /// Add noise-only rows on the back hemisphere of an opaque sample.
     pub back_rows: bool,
     /// Aperture-averaging rays per cone (per axis: n × n).
@@ -162,6 +166,7 @@ impl Default for Instrument {
             noise_floor: 1e-3,
             blind_spot_deg: 3.0,
             holder_gap: true,
+            holder_shadow: false,
             back_rows: true,
             aperture_rays: 3,
         }
@@ -351,7 +356,9 @@ pub fn synthesize(spec: &SynthSpec) -> Measurement {
         };
         // The file holds what its colorimetry header says: CIE Y, or CIE
         // XYZ, of the material's Radiance RGB.
-        let rgb = mean.map(|m| m / n);
+        let relative = (phi - spec.incidence.phi_deg - 270.0 + 540.0).rem_euclid(360.0) - 180.0;
+        let shadowed = instrument.holder_shadow && front_theta >= 73.5 && relative.abs() <= 45.0;
+        let rgb = mean.map(|m| m / n * if shadowed { 0.01 } else { 1.0 });
         let values = match spec.channels {
             Channels::Y => [noisy(brtf_model::luminance(rgb), &mut rng), 0.0, 0.0],
             Channels::Xyz => {

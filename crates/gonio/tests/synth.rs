@@ -21,6 +21,7 @@ fn clean() -> Instrument {
         noise_floor: 0.0,
         blind_spot_deg: 0.0,
         holder_gap: false,
+        holder_shadow: false,
         back_rows: false,
         aperture_rays: 1,
     }

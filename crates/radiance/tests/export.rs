@@ -98,6 +98,7 @@ fn fit(
                     klems: None,
                     phi_turn_deg: 0.0,
                     peak_arc_deg: None,
+                    shadows: Vec::new(),
                 })
                 .collect(),
         },

@@ -4,8 +4,9 @@
 use crate::WorkflowError;
 use brtf_fit::klems::IncidenceFilter;
 use brtf_fit::{
-    AzimuthRule, ColourConversion, FitConfig, FitSetOptions, Interpolation, KnownReflectance,
-    ModelChoice, Recipe, ResidualKind, RobustLoss, ScaleRule, SelectionOptions, WeightRule,
+    AzimuthRule, ColourConversion, FitConfig, FitSetOptions, HolderMask, Interpolation,
+    KnownReflectance, ModelChoice, Recipe, ResidualKind, RobustLoss, ScaleRule, SelectionOptions,
+    WeightRule,
 };
 use brtf_gonio::Hemispheres;
 use brtf_gonio::klems::Sides;
@@ -52,8 +53,8 @@ pub struct FitSettings {
     pub hemisphere: Option<Hemispheres>,
     /// Samples below this value are dropped.
     pub min_value: Option<f64>,
-    /// Mask the pgII holder's shadow.
-    pub mask_holder: bool,
+    /// Mask the pgII holder's shadow: its fixed band or the shadows found.
+    pub mask_holder: Option<HolderMask>,
     /// How φ_out is aligned with the plane of incidence (`None`: the
     /// peak aligned for gonio scans fitted with an isotropic model or
     /// `auto`; the file's frame for anisotropic models and Klems XML).
@@ -97,7 +98,7 @@ impl FitSettings {
             beam_mask: 3.0,
             hemisphere: None,
             min_value: None,
-            mask_holder: false,
+            mask_holder: None,
             phi_offset: None,
             beam_integral: None,
             rho: None,

@@ -89,9 +89,9 @@ pub(crate) struct FitArgs {
     /// Drop samples whose value is below this (in the data's unit).
     #[arg(long)]
     pub min_value: Option<f64>,
-    /// Mask the pgII sample holder's shadow: φ_out 270 ± 15° at θ_out ≥ 70°.
-    #[arg(long)]
-    pub mask_holder: bool,
+    /// Mask the pgII sample holder's shadow: alone or `band`, φ_out − φ_in 270 ± 45° at θ_out ≥ 73°; `auto`, the regions found far below their mirror across the plane of incidence
+    #[arg(long, num_args = 0..=1, default_missing_value = "band", value_parser = words::<brtf_fit::HolderMask>())]
+    pub mask_holder: Option<brtf_fit::HolderMask>,
     /// Turn of φ_out: `auto` turns it so that the data's specular peak lies in the plane of incidence (when 0.5° or more out of it), a number turns it by that many degrees, 0 keeps the file's frame [default: auto]
     #[arg(long, value_parser = |s: &str| s.parse::<brtf_fit::AzimuthRule>())]
     pub phi_offset: Option<brtf_fit::AzimuthRule>,

@@ -502,24 +502,24 @@ fn the_min_value_gate_removes_low_values_and_unavailable_comes_first() {
 
 #[test]
 fn the_holder_mask_removes_its_azimuth_band_at_grazing_angles() {
-    // PGII_HOLDER_BAND: φ_out 270 ± 15° at θ_out ≥ 70° (edges included),
-    // from the nearer normal.
+    // PGII_HOLDER_BAND: φ_out − φ_in 270 ± 45° at θ_out ≥ 73° (edges
+    // included), from the nearer normal; the light at φ_in 0.
     let dirs = vec![
         (75.0, 270.0),
-        (75.0, 260.0),
-        (80.0, 285.0),
-        (80.0, 255.0),
-        (80.0, 286.0),
-        (75.0, 250.0),
-        (69.0, 270.0),
-        (70.0, 270.0),
+        (75.0, 230.0),
+        (80.0, 315.0),
+        (80.0, 225.0),
+        (80.0, 316.0),
+        (75.0, 224.0),
+        (72.0, 270.0),
+        (73.0, 270.0),
         (75.0, 90.0),
         (110.0, 270.0),
         (30.0, 270.0),
     ];
     let p = check_gates(30.0, samples(&dirs, f), vec![PGII_HOLDER_BAND], |s| {
         let theta = s.theta_deg.min(180.0 - s.theta_deg);
-        ((s.phi_deg - 270.0).abs() <= 15.0 && theta >= 70.0).then_some(0)
+        ((s.phi_deg - 270.0).abs() <= 45.0 && theta >= 73.0).then_some(0)
     });
     assert_eq!(p.gates[0].removed, 6);
 }
@@ -531,7 +531,7 @@ fn each_sample_is_removed_by_the_first_gate_it_fails() {
         theta_cap: 60.0,
         beam_mask: 3.0,
         min_value: Some(0.1),
-        mask_holder: true,
+        mask_holder: Some(crate::HolderMask::Band),
     }
     .gates(false);
     assert_eq!(
@@ -557,7 +557,7 @@ fn each_sample_is_removed_by_the_first_gate_it_fails() {
         (Sample::luminance(30.0, 0.0, 0.0), Some(3)),         // beam, min
         (Sample::luminance(40.0, 180.0, 0.05), Some(4)),      // min
         (Sample::luminance(40.0, 180.0, 0.5), None),
-        (Sample::luminance(60.0, 270.0, 0.5), None), // below the band's 70°
+        (Sample::luminance(60.0, 270.0, 0.5), None), // below the band's 73°
     ];
     let (samples, expected): (Vec<Sample>, Vec<Option<usize>>) = cases.into_iter().unzip();
     let p = check_gates_listed(30.0, samples, gates, expected);
@@ -574,7 +574,7 @@ fn selection_options_leave_out_what_is_off_and_what_klems_data_cannot_use() {
         theta_cap: 85.0,
         beam_mask: 0.0,
         min_value: None,
-        mask_holder: false,
+        mask_holder: None,
     };
     assert_eq!(
         options.gates(false),
