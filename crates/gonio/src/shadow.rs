@@ -204,7 +204,7 @@ pub fn detect(
         scan.regions
             .push(describe(&region, &members, directions, phi_in_deg));
     }
-    scan.regions.sort_by(|a, b| b.samples.cmp(&a.samples));
+    scan.regions.sort_by_key(|r| std::cmp::Reverse(r.samples));
     scan
 }
 
