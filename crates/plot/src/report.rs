@@ -410,7 +410,15 @@ fn provenance_section(out: &mut String, dir: &Path, result: &FitResult) {
             num(i.theta_in),
             num(i.phi_in),
             i.samples,
-            esc(&format!("{}{}", i.conversion, i.describe_turn())),
+            esc(&format!(
+                "{}{}{}",
+                i.conversion,
+                i.describe_turn(),
+                i.shadows
+                    .iter()
+                    .map(|r| format!("; shadow masked: {r}"))
+                    .collect::<String>()
+            )),
             esc(&i.sha256)
         );
     }
