@@ -141,7 +141,7 @@ def test_fit_equals_brtf_fit_on_golden_paper(cli, tmp_path, golden_paper, option
     assert py_inc.n_points == cli_inc["n_points"]
     assert py_inc.termination == brtf.Fit.load(out).incidences[0].termination
     turn = cli_json["provenance"]["inputs"][0].get("phi_turn_deg", 0.0)
-    assert turn == options.get("phi_offset", pytest.approx(3.4356, abs=1e-3))
+    assert turn == options.get("phi_offset", pytest.approx(3.44, abs=0.02))
     for p in cli_inc["params"]:
         if p["stderr"] is not None:
             assert py_inc.stderr[p["name"]] == pytest.approx(p["stderr"], rel=1e-6)

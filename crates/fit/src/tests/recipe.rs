@@ -521,7 +521,7 @@ fn the_holder_mask_removes_its_azimuth_band_at_grazing_angles() {
         let theta = s.theta_deg.min(180.0 - s.theta_deg);
         ((s.phi_deg - 270.0).abs() <= 45.0 && theta >= 73.0).then_some(0)
     });
-    assert_eq!(p.gates[0].removed, 6);
+    assert_eq!(p.gates[0].removed, 5);
 }
 
 #[test]
