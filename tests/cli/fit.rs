@@ -766,3 +766,58 @@ fn multi_start_is_never_worse_than_its_candidates_or_one_start() {
         }
     }
 }
+
+/// Each warning kind is said once: in the summary of the shipped set (the
+/// roughness moves with log residuals on all five incidences) and in
+/// report.html's "Read this first" box, one entry per kind.
+#[test]
+fn each_warning_kind_is_said_once() {
+    let dir = temp_dir();
+    let out = dir.path().join("alu");
+    let files: Vec<String> = ["0", "15", "30", "45", "60"]
+        .iter()
+        .map(|t| s(&repo_path(&format!("data/alu-ggx/alu-ggx:+{t}+0.mpc"))).to_string())
+        .collect();
+    let mut args: Vec<&str> = vec!["fit"];
+    args.extend(files.iter().map(String::as_str));
+    args.extend(["--model", "metal", "--out", s(&out)]);
+    let printed = brtf(&args, "").ok();
+    let section = printed
+        .split("warnings, one line per kind")
+        .nth(1)
+        .expect("a warnings section");
+    let lines: Vec<&str> = section
+        .lines()
+        .skip(1)
+        .take_while(|l| l.starts_with("  "))
+        .collect();
+    assert!(lines.len() >= 2, "{printed}");
+    assert_eq!(
+        printed.matches("moves with another residual kind").count(),
+        1,
+        "{printed}"
+    );
+    assert!(
+        printed.contains(
+            "rough moves with another residual kind (Log): 5 incidences (θ_in 0–60°); e.g."
+        ),
+        "{printed}"
+    );
+    let report = std::fs::read_to_string(out.join("report.html")).unwrap();
+    let read_first = report
+        .split("Read this first")
+        .nth(1)
+        .and_then(|r| r.split("</section>").next())
+        .unwrap();
+    assert_eq!(
+        read_first.matches("<li>").count(),
+        lines.len(),
+        "{read_first}"
+    );
+    assert_eq!(
+        read_first
+            .matches("moves with another residual kind")
+            .count(),
+        1
+    );
+}

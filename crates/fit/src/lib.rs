@@ -83,5 +83,5 @@ pub use set::{
     FitSetError, FitSetOptions, FittedSet, KlemsOptions, NoProgress, Progress, fit_set,
     fit_set_with_data, prepare_input,
 };
-pub use summary::summary;
+pub use summary::{summary, warning_lines};
 pub use table::{AzimuthRing, Interpolation, ParamTable, TableError, TableLookup, azimuth_from_u};

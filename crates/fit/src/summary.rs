@@ -87,24 +87,15 @@ pub fn summary(result: &FitResult, out: &Path) -> String {
     let _ = writeln!(s, "(! = at a bound, = = held fixed)");
     auto_table(&mut s, result);
     adequacy_table(&mut s, result);
-    let global = result.global.iter().filter(|_| result.incidences.len() > 1);
-    let labelled = result
-        .incidences
-        .iter()
-        .map(|r| (r, format!("{} (θ_in {})", r.source, r.theta_in)))
-        .chain(global.map(|r| (r, "all incidences".to_string())));
     // The set's own warnings go to stderr (the CLI prints them).
-    if result.incidences.len() > GROUP_ABOVE {
-        grouped_warnings(&mut s, result);
-    } else {
-        let warnings: Vec<String> = labelled
-            .flat_map(|(r, label)| r.warnings.iter().map(move |w| format!("{label}: {w}")))
-            .collect();
-        if !warnings.is_empty() {
-            let _ = writeln!(s, "\nwarnings:");
-            for w in &warnings {
-                let _ = writeln!(s, "  {w}");
-            }
+    let warnings = warning_lines(result);
+    if !warnings.is_empty() {
+        let _ = writeln!(
+            s,
+            "\nwarnings, one line per kind (each incidence's own are in fit.json and report.html):"
+        );
+        for w in &warnings {
+            let _ = writeln!(s, "  {w}");
         }
     }
     if let Some(g) = &result.global {
@@ -137,10 +128,7 @@ pub fn summary(result: &FitResult, out: &Path) -> String {
     s
 }
 
-/// Above this many incidences (a Klems side has 145) the inputs are listed
-/// per file and the warnings per kind: the same three warnings on every
-/// incidence would otherwise bury the table. fit.json and the report keep
-/// every incidence's own list.
+/// Above this many inputs (a Klems side has 145) they are listed per file.
 const GROUP_ABOVE: usize = 12;
 
 /// One line per input file: how many incidences it gave, over which θ_in.
@@ -176,46 +164,74 @@ fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     })
 }
 
-/// The incidences' warnings grouped by kind (and parameter): how many
-/// incidences, over which θ_in, and one example in full; then the
-/// all-incidence fit's own.
-fn grouped_warnings(s: &mut String, result: &FitResult) {
-    // (kind, incidences with it, θ_in range, first example)
-    let mut groups: Vec<(String, usize, (f64, f64), String)> = Vec::new();
-    for r in &result.incidences {
+/// The fit's warnings, one line per kind (and parameter): a kind that one
+/// incidence has, in full with its incidence; one that several have, how
+/// many, over which θ_in, and one example in full; the all-incidence fit's
+/// own (with several incidences) counted with its kind. What the summary
+/// and report.html show; fit.json keeps every incidence's own list.
+pub fn warning_lines(result: &FitResult) -> Vec<String> {
+    struct Group {
+        kind: String,
+        incidences: usize,
+        theta: (f64, f64),
+        global: bool,
+        example: String,
+    }
+    let mut groups: Vec<Group> = Vec::new();
+    let global = result.global.iter().filter(|_| result.incidences.len() > 1);
+    let reports = result
+        .incidences
+        .iter()
+        .map(|r| (r, false))
+        .chain(global.map(|r| (r, true)));
+    for (r, is_global) in reports {
         for w in &r.warnings {
             let kind = warning_kind(w);
-            let example = format!("{} (θ_in {}): {w}", r.source, r.theta_in);
-            match groups.iter_mut().find(|g| g.0 == kind) {
-                Some(g) => {
-                    g.1 += 1;
-                    g.2 = (g.2.0.min(r.theta_in), g.2.1.max(r.theta_in));
+            let example = if is_global {
+                format!("all incidences: {w}")
+            } else {
+                format!("{} (θ_in {}): {w}", r.source, r.theta_in)
+            };
+            let group = match groups.iter_mut().position(|g| g.kind == kind) {
+                Some(i) => &mut groups[i],
+                None => {
+                    groups.push(Group {
+                        kind,
+                        incidences: 0,
+                        theta: (f64::INFINITY, f64::NEG_INFINITY),
+                        global: false,
+                        example,
+                    });
+                    groups.last_mut().expect("just pushed")
                 }
-                None => groups.push((kind, 1, (r.theta_in, r.theta_in), example)),
+            };
+            if is_global {
+                group.global = true;
+            } else {
+                group.incidences += 1;
+                group.theta = (group.theta.0.min(r.theta_in), group.theta.1.max(r.theta_in));
             }
         }
     }
-    let global: Vec<String> = result
-        .global
-        .iter()
-        .filter(|_| result.incidences.len() > 1)
-        .flat_map(|g| g.warnings.iter().map(|w| format!("all incidences: {w}")))
-        .collect();
-    if groups.is_empty() && global.is_empty() {
-        return;
-    }
-    let _ = writeln!(
-        s,
-        "\nwarnings, by kind ({} incidences; each incidence's own are in fit.json and report.html):",
-        result.incidences.len()
-    );
-    for (kind, count, (lo, hi), example) in &groups {
-        let _ = writeln!(s, "  {kind}: {count} incidences, θ_in {lo}–{hi}°");
-        let _ = writeln!(s, "    e.g. {example}");
-    }
-    for w in &global {
-        let _ = writeln!(s, "  {w}");
-    }
+    groups
+        .into_iter()
+        .map(|g| {
+            if g.incidences + usize::from(g.global) <= 1 {
+                return g.example;
+            }
+            let (lo, hi) = g.theta;
+            let also = if g.global {
+                " and the all-incidence fit"
+            } else {
+                ""
+            };
+            let (count, theta) = match g.incidences {
+                1 => ("1 incidence".to_string(), format!("θ_in {lo}°")),
+                n => (format!("{n} incidences"), format!("θ_in {lo}–{hi}°")),
+            };
+            format!("{}: {count} ({theta}){also}; e.g. {}", g.kind, g.example)
+        })
+        .collect()
 }
 
 /// What a warning is about, without its numbers.

@@ -505,20 +505,9 @@ pub(crate) fn html(input: &ReportInput) -> String {
          <a href=\"#provenance\">Provenance</a></nav>",
     );
 
-    // With one incidence the all-incidence fit is that fit: its warnings
-    // once, not twice.
-    let global = result
-        .global
-        .iter()
-        .filter(|_| result.incidences.len() > 1)
-        .map(|r| (r, "all incidences".to_string()));
-    let fit_warnings: Vec<String> = result
-        .incidences
-        .iter()
-        .map(|r| (r, format!("{} (θ_in {}°)", r.source, num(r.theta_in))))
-        .chain(global)
-        .flat_map(|(r, label)| r.warnings.iter().map(move |w| format!("{label}: {w}")))
-        .collect();
+    // One entry per kind (with one incidence the all-incidence fit is that
+    // fit: its warnings once, not twice).
+    let fit_warnings = brtf_fit::warning_lines(result);
     if !input.warnings.is_empty() || !fit_warnings.is_empty() {
         out.push_str(
             "<section id=\"warnings\" class=\"warn\"><strong>Read this first</strong><ul>\n",
