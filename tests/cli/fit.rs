@@ -821,3 +821,28 @@ fn each_warning_kind_is_said_once() {
         1
     );
 }
+
+/// `--rho` given a header's detector integral (µA·sr, not a reflectance)
+/// is taken, but said to be one; a real reflectance is not.
+#[test]
+fn a_rho_from_a_header_integral_is_named_for_what_it_is() {
+    let dir = temp_dir();
+    let scan = real_scan("golden_paper.txt");
+    let run = |rho: &str| {
+        let out = dir.path().join(rho);
+        let args = ["fit", s(&scan), "--model", "metal", "--gray", "--rho", rho];
+        let run = brtf(
+            &[&args[..], &["--no-plots", "--no-export", "--out", s(&out)]].concat(),
+            "",
+        );
+        assert!(run.success, "{run}");
+        run.stderr
+    };
+    let header = run("0.0263@26.8421");
+    assert!(
+        header.contains("--rho 0.0263 equals the header's #")
+            && header.contains("in uA·sr, not a reflectance"),
+        "{header}"
+    );
+    assert!(!run("0.85@26.8421").contains("equals the header"));
+}

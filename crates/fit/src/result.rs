@@ -112,6 +112,18 @@ pub enum SetWarning {
         /// The incidence used, degrees.
         used: f64,
     },
+    /// `--rho` equals a detector integral from the file's header, which
+    /// is in the file's unit × sr, not a reflectance.
+    RhoFromHeader {
+        /// The `--rho` value.
+        rho: f64,
+        /// The header key (without `#`).
+        key: String,
+        /// The header's number, as written.
+        value: String,
+        /// The file's unit.
+        unit: String,
+    },
 }
 
 impl std::fmt::Display for SetWarning {
@@ -123,6 +135,17 @@ impl std::fmt::Display for SetWarning {
             SetWarning::RhoFarFromIncidence { requested, used } => write!(
                 f,
                 "--rho given at θ_in {requested}°, nearest fitted incidence is {used}°"
+            ),
+            SetWarning::RhoFromHeader {
+                rho,
+                key,
+                value,
+                unit,
+            } => write!(
+                f,
+                "--rho {rho} equals the header's #{key} value {value}: that is the detector \
+                 signal integrated over the sphere, in {unit}·sr, not a reflectance; give the \
+                 sample's measured directional-hemispherical reflectance"
             ),
         }
     }

@@ -265,6 +265,7 @@ pub fn fit_set_with_data(
                 used: reports[nearest].theta_in,
             });
         }
+        warnings.extend(rho_from_header(&inputs[nearest].prepared, rho));
         let k = instrument_scale(
             &config,
             &inputs[nearest].prepared,
@@ -434,6 +435,35 @@ pub fn prepare_input(
             Ok(recipe.prepare(measurement, &input.path)?)
         }
     }
+}
+
+/// A warning when `rho` equals, to its printed digits, a number of one of
+/// the header's integrals (`#integrated_value`, `#front_integral`, …):
+/// detector integrals a user may take for a reflectance.
+fn rho_from_header(prepared: &PreparedMeasurement, rho: f64) -> Option<SetWarning> {
+    let unit = match &prepared.conversion {
+        crate::Conversion::Raw { unit, .. } => unit.clone(),
+        _ => return None,
+    };
+    // Of the numbers it matches, the one written with the most digits.
+    let pairs = prepared.measurement.header_pairs();
+    let (key, value, _) = pairs
+        .iter()
+        .filter(|(key, _)| key.contains("integral") || key.contains("integrated"))
+        .flat_map(|(key, value)| value.split_whitespace().map(move |word| (key, word)))
+        .filter_map(|(key, word)| {
+            let number = word.parse::<f64>().ok()?;
+            let decimals = word.split_once('.').map_or(0, |(_, d)| d.len()) as i32;
+            let close = (number - rho).abs() < 0.5 * 10f64.powi(-decimals) * (1.0 + 1e-9);
+            close.then_some((key, word, decimals))
+        })
+        .max_by_key(|m| m.2)?;
+    Some(SetWarning::RhoFromHeader {
+        rho,
+        key: key.clone(),
+        value: value.to_string(),
+        unit,
+    })
 }
 
 /// K such that the data ÷ K have the reflectance `rho` at their incidence:
