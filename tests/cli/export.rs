@@ -1065,3 +1065,20 @@ fn synthetic(material: &Material, theta_in: f64) -> IncidenceData {
         cosine_weighted: false,
     }
 }
+
+/// A fit of one incidence says so in its `.rad` header, not "the
+/// all-incidence fit (1 incidences, …)".
+#[test]
+fn a_one_incidence_export_names_its_incidence() {
+    let dir = temp_dir();
+    let out = dir.path().join("one");
+    let scan = crate::fit::real_scan("golden_paper.txt");
+    let args = ["fit", s(&scan), "--model", "metal", "--gray", "--no-plots"];
+    brtf(&[&args[..], &["--out", s(&out)]].concat(), "").ok();
+    let rad = std::fs::read_to_string(out.join("Golden_glossy_paper.rad")).unwrap();
+    assert!(
+        rad.contains("# Parameters: the fit of the one incidence, theta_in = 26.8421 deg ("),
+        "{rad}"
+    );
+    assert!(!rad.contains("1 incidences"), "{rad}");
+}

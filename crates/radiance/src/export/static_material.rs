@@ -133,12 +133,17 @@ pub(crate) fn text(result: &FitResult, chosen: &Chosen, name: &str, with_theta: 
     }
     match chosen.origin {
         Origin::Global(r) => {
-            h.push(format!(
-                "Parameters: the all-incidence fit ({} incidences, theta_in {}-{} deg).",
-                result.incidences.len(),
-                lo,
-                hi
-            ));
+            h.push(match result.incidences.as_slice() {
+                [one] => format!(
+                    "Parameters: the fit of the one incidence, theta_in = {} deg ({}).",
+                    one.theta_in,
+                    ascii(&one.source)
+                ),
+                all => format!(
+                    "Parameters: the all-incidence fit ({} incidences, theta_in {lo}-{hi} deg).",
+                    all.len()
+                ),
+            });
             h.push(format!("Fit quality: {}.", report::quality(r)));
             caveats.extend(report::fit_caveats(r));
         }
