@@ -466,3 +466,40 @@ fn images_match_live_rpict() {
         100.0 * worst
     );
 }
+
+/// A point beam and detector on a point-source fit render the fitted model
+/// itself: `brtf check` says the comparison cannot fail, and says nothing
+/// when the apertures are finite.
+#[test]
+fn a_point_check_of_a_point_fit_says_it_is_a_tautology() {
+    let dir = temp_dir();
+    let out = dir.path().join("fit");
+    let scan = crate::common::repo_path("data/alu-ggx/alu-ggx:+30+0.mpc");
+    let args = [
+        "fit",
+        s(&scan),
+        "--model",
+        "metal",
+        "--no-plots",
+        "--no-export",
+    ];
+    brtf(&[&args[..], &["--out", s(&out)]].concat(), "").ok();
+    let point = brtf(&["check", s(&out)], "").ok();
+    assert!(
+        point.contains("render − model is 0 by construction"),
+        "{point}"
+    );
+    let finite = brtf(
+        &[
+            "check",
+            s(&out),
+            "--source-omega",
+            "1e-4",
+            "--detector-omega",
+            "1e-4",
+        ],
+        "",
+    )
+    .ok();
+    assert!(!finite.contains("by construction"), "{finite}");
+}

@@ -614,6 +614,24 @@ impl std::fmt::Display for CheckReport {
             f,
             "beam {:.3e} sr (fit model: {:.3e} sr), detector {:.3e} sr, {} rays per direction",
             self.source_omega, self.fit_source_omega, self.detector_omega, self.samples
-        )
+        )?;
+        if self.is_tautology() {
+            writeln!(
+                f,
+                "note: a point beam and a point detector on a point-source fit: the render \
+                 evaluates the fitted model itself, so render − model is 0 by construction and \
+                 render − data repeats the fit; give --source-omega and --detector-omega (the \
+                 instrument's apertures) for a check that can fail"
+            )?;
+        }
+        Ok(())
+    }
+}
+
+impl CheckReport {
+    /// True when the check cannot differ from the fit: a point beam and a
+    /// point detector on a fit made with a point source.
+    pub fn is_tautology(&self) -> bool {
+        self.source_omega == 0.0 && self.detector_omega == 0.0 && self.fit_source_omega == 0.0
     }
 }
