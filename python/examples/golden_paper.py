@@ -72,7 +72,7 @@ peak_data = signed[np.nanargmax(scan.value[in_plane, 0])]
 peak_model = signed[np.argmax(model)]
 assert abs(peak_data - peak_model) < 2.0, (peak_data, peak_model)
 
-# 4. Export: the static Radiance material (and a preview scene), as
+# 4. Export: the static Radiance material (a free-scale fit gets no preview scene), as
 #    `brtf export`; `fit.save(folder)` would write the whole `brtf fit` folder.
 for path in fit.export(args.out / "export"):
     print("wrote", path)

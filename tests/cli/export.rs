@@ -1082,3 +1082,31 @@ fn a_one_incidence_export_names_its_incidence() {
     );
     assert!(!rad.contains("1 incidences"), "{rad}");
 }
+
+/// A free-scale fit's material is not renderable as is: its first line
+/// says so and no preview scene is written.
+#[test]
+fn a_free_scale_export_says_it_is_not_renderable_and_has_no_preview() {
+    let dir = temp_dir();
+    let out = dir.path().join("free");
+    let scan = crate::fit::real_scan("golden_paper.txt");
+    let args = ["fit", s(&scan), "--model", "metal", "--gray", "--no-plots"];
+    let run = brtf(&[&args[..], &["--out", s(&out)]].concat(), "");
+    let printed = format!("{}{}", run.stdout, run.stderr);
+    assert!(run.success, "{printed}");
+    let rad = std::fs::read_to_string(out.join("Golden_glossy_paper.rad")).unwrap();
+    assert!(rad.starts_with("# NOT RENDERABLE AS IS: "), "{rad}");
+    assert!(!out.join("Golden_glossy_paper-preview.rad").exists());
+    assert!(
+        printed.contains("no preview scene for a free-scale fit"),
+        "{printed}"
+    );
+    // With a known reflectance it is absolute: renderable, with its scene.
+    let absolute = dir.path().join("absolute");
+    let args = ["fit", s(&scan), "--model", "metal", "--gray", "--no-plots"];
+    let known = ["--rho", "0.85@26.8421", "--out", s(&absolute)];
+    brtf(&[&args[..], &known[..]].concat(), "").ok();
+    let rad = std::fs::read_to_string(absolute.join("Golden_glossy_paper.rad")).unwrap();
+    assert!(!rad.contains("NOT RENDERABLE"), "{rad}");
+    assert!(absolute.join("Golden_glossy_paper-preview.rad").exists());
+}

@@ -201,7 +201,13 @@ pub fn exports(result: &FitResult, options: &ExportOptions) -> Result<Export, Ex
             text: theta.cal,
         });
     }
-    if options.preview {
+    if options.preview && result.config.free_scale {
+        notes.push(
+            "no preview scene for a free-scale fit (refit with --rho VALUE@THETA or \
+             --beam-integral B for a renderable material)"
+                .into(),
+        );
+    } else if options.preview {
         files.push(ExportFile {
             file_name: preview_file_name(&name),
             text: preview::text(result, &name, files.len() > 1),

@@ -108,14 +108,22 @@ pub(crate) fn text(result: &FitResult, chosen: &Chosen, name: &str, with_theta: 
     } else {
         kind.to_string()
     };
-    let mut h: Vec<String> = vec![
+    let mut h: Vec<String> = Vec::new();
+    if result.config.free_scale {
+        h.push(
+            "NOT RENDERABLE AS IS: fitted with a free scale (raw signal of unknown scale), so \
+             its reflectance is relative; refit with --rho VALUE@THETA or --beam-integral B."
+                .into(),
+        );
+    }
+    h.extend([
         format!(
             "{}: static Radiance {what} \"{name}\", written by brtf {} (brtf export).",
             super::static_file_name(name),
             env!("CARGO_PKG_VERSION")
         ),
         String::new(),
-    ];
+    ]);
     h.extend(report::provenance(result));
     h.push(String::new());
     let (lo, hi) = result
@@ -127,7 +135,7 @@ pub(crate) fn text(result: &FitResult, chosen: &Chosen, name: &str, with_theta: 
     let mut caveats: Vec<String> = report::scale_caveat(result).into_iter().collect();
     if !caveats.is_empty() {
         notes.push(format!(
-            "{}: the fit had a free scale, so the colour is relative (see its header)",
+            "{}: not renderable as is: the fit had a free scale, so its reflectance is relative (see its header)",
             super::static_file_name(name)
         ));
     }
