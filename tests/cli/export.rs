@@ -169,6 +169,7 @@ fn result_of(
                     phi_turn_deg: 0.0,
                     peak_arc_deg: None,
                     shadows: Vec::new(),
+                    channels: 0,
                 })
                 .collect(),
         },

@@ -846,3 +846,66 @@ fn a_rho_from_a_header_integral_is_named_for_what_it_is() {
     );
     assert!(!run("0.85@26.8421").contains("equals the header"));
 }
+
+/// A one-channel scan's colour was never measured: the summary, fit.json,
+/// report.html and the `.rad` header say so; a three-channel fit does not.
+#[test]
+fn a_one_channel_fit_says_its_colour_was_not_measured() {
+    let dir = temp_dir();
+    let out = dir.path().join("grey");
+    let scan = real_scan("golden_paper.txt");
+    let args = ["fit", s(&scan), "--model", "metal", "--out", s(&out)];
+    let printed = brtf(&args, "").ok();
+    assert!(
+        printed.contains("colour not measured (one-channel CIE-Y data)"),
+        "{printed}"
+    );
+    let result = brtf_fit::FitResult::read(&out.join("fit.json")).unwrap();
+    assert_eq!(result.provenance.inputs[0].channels, 1);
+    assert_eq!(result.colour_measured(), Some(false));
+    let report = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(report.contains("colour not measured (one-channel CIE-Y data)"));
+    let rad = std::fs::read_to_string(out.join("Golden_glossy_paper.rad")).unwrap();
+    assert!(
+        rad.contains("# Colour: not measured (one-channel CIE-Y data)"),
+        "{rad}"
+    );
+    // A three-channel scan's colour was measured.
+    let truth = crate::common::write_file(
+        dir.path(),
+        "m.rad",
+        "void metal m\n0\n0\n5 0.9 0.6 0.3 0.9 0.1\n",
+    );
+    let scans = dir.path().join("scans");
+    let synth = [
+        "synth",
+        "--material",
+        s(&truth),
+        "--theta-in",
+        "30",
+        "--channels",
+        "3",
+    ];
+    let more = ["--format", "mountain", "--out", s(&scans)];
+    brtf(&[&synth[..], &more[..]].concat(), "").ok();
+    let file = std::fs::read_dir(&scans)
+        .unwrap()
+        .next()
+        .unwrap()
+        .unwrap()
+        .path();
+    let colour = dir.path().join("colour");
+    let args = [
+        "fit",
+        s(&file),
+        "--model",
+        "metal",
+        "--no-plots",
+        "--out",
+        s(&colour),
+    ];
+    let printed = brtf(&args, "").ok();
+    assert!(!printed.contains("colour not measured"), "{printed}");
+    let result = brtf_fit::FitResult::read(&colour.join("fit.json")).unwrap();
+    assert_eq!(result.colour_measured(), Some(true));
+}

@@ -47,6 +47,10 @@ pub struct InputFile {
     /// The shadows `--mask-holder auto` found and masked.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub shadows: Vec<brtf_gonio::shadow::ShadowRegion>,
+    /// Channels fitted: 1 (CIE Y, colour not measured) or 3; 0 in fits
+    /// saved before the field.
+    #[serde(default)]
+    pub channels: usize,
 }
 
 fn is_zero(x: &f64) -> bool {
@@ -370,6 +374,17 @@ impl FitResult {
     /// The evaluation options the fit used (variant, Fresnel constant, ω).
     pub fn options(&self) -> EvalOptions {
         self.config.options
+    }
+
+    /// `Some(false)` when every input had one channel (CIE Y): the colour
+    /// was never measured and the material is grey; `Some(true)` when
+    /// some had three; `None` when the fit did not record it.
+    pub fn colour_measured(&self) -> Option<bool> {
+        let inputs = &self.provenance.inputs;
+        if inputs.is_empty() || inputs.iter().any(|i| i.channels == 0) {
+            return None;
+        }
+        Some(inputs.iter().any(|i| i.channels >= 3))
     }
 
     /// The material (any shape) of a report's fitted arguments.

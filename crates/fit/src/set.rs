@@ -382,6 +382,7 @@ fn read_input(
                 phi_turn_deg: prepared.phi_turn_deg,
                 peak_arc_deg: prepared.peak_arc_deg,
                 shadows: prepared.shadows.clone(),
+                channels: prepared.channels(),
             },
             prepared,
         }

@@ -37,6 +37,12 @@ pub fn summary(result: &FitResult, out: &Path) -> String {
             }
         }
     }
+    if result.colour_measured() == Some(false) {
+        let _ = writeln!(
+            s,
+            "  colour not measured (one-channel CIE-Y data): the material is grey, R = G = B"
+        );
+    }
     let names: Vec<&str> = result
         .incidences
         .first()

@@ -428,7 +428,7 @@ fn provenance_section(out: &mut String, dir: &Path, result: &FitResult) {
         out,
         "<table id=\"config\"><tbody>\
          <tr><th class=\"l\">model</th><td class=\"l\">{} ({} variant, Fresnel K {}, source ω {} sr)</td></tr>\
-         <tr><th class=\"l\">gray (R = G = B)</th><td class=\"l\">{}</td></tr>\
+         <tr><th class=\"l\">colour</th><td class=\"l\">{}</td></tr>\
          <tr><th class=\"l\">free scale</th><td class=\"l\">{}</td></tr>\
          <tr><th class=\"l\">residuals</th><td class=\"l\">{:?}, floor {}</td></tr>\
          <tr><th class=\"l\">robust loss</th><td class=\"l\">{:?}</td></tr>\
@@ -440,7 +440,11 @@ fn provenance_section(out: &mut String, dir: &Path, result: &FitResult) {
         esc(c.options.variant.name()),
         c.options.fresnel_k,
         c.options.source_omega,
-        c.gray,
+        match (result.colour_measured(), c.gray) {
+            (Some(false), _) => "colour not measured (one-channel CIE-Y data): grey, R = G = B",
+            (_, true) => "grey (R = G = B, --gray)",
+            _ => "red, green and blue fitted",
+        },
         c.free_scale,
         c.residual,
         c.floor.map_or("auto".into(), fmt),

@@ -99,6 +99,7 @@ fn fit(
                     phi_turn_deg: 0.0,
                     peak_arc_deg: None,
                     shadows: Vec::new(),
+                    channels: 0,
                 })
                 .collect(),
         },

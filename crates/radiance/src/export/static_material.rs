@@ -125,6 +125,12 @@ pub(crate) fn text(result: &FitResult, chosen: &Chosen, name: &str, with_theta: 
         String::new(),
     ]);
     h.extend(report::provenance(result));
+    if result.colour_measured() == Some(false) {
+        h.push(
+            "Colour: not measured (one-channel CIE-Y data): the material is grey, R = G = B."
+                .into(),
+        );
+    }
     h.push(String::new());
     let (lo, hi) = result
         .table
