@@ -332,8 +332,20 @@ fn free_scale_and_missing_global_fit_are_reported() {
         "{text}"
     );
     assert!(file(&export, "painted-theta.rad").contains("free overall scale"));
+    // Not renderable as is: said first, and no preview scene.
+    assert!(text.starts_with("# NOT RENDERABLE AS IS: "), "{text}");
+    assert!(
+        export
+            .files
+            .iter()
+            .all(|f| !f.file_name.ends_with("-preview.rad"))
+    );
     let notes = export.notes.join("\n");
-    assert!(notes.contains("colour is relative"), "{notes}");
+    assert!(notes.contains("not renderable as is"), "{notes}");
+    assert!(
+        notes.contains("no preview scene for a free-scale fit"),
+        "{notes}"
+    );
     assert!(notes.contains("no all-incidence fit"), "{notes}");
 }
 
