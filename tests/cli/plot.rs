@@ -355,7 +355,7 @@ fn the_report_opens_in_headless_chromium_without_errors() {
                     "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
                     "--no-first-run", "--disable-background-networking",
                     "--disable-component-update", "--disable-sync", "--disable-dev-shm-usage",
-                    "--window-size=1400,1000",
+                    "--window-size=1280,1000",
                     format!("--user-data-dir={}", s(&profile)),
                 ]
             },
@@ -382,6 +382,7 @@ fn the_report_opens_in_headless_chromium_without_errors() {
                 title: document.title,
                 rows: t ? t.querySelectorAll('tbody tr').length : -1,
                 tableHeight: t ? t.getBoundingClientRect().height : 0,
+                tableOverflow: t ? t.getBoundingClientRect().right - document.documentElement.clientWidth : 1e9,
                 images: document.images.length,
                 broken: Array.from(document.images)
                     .filter(i => !i.complete || i.naturalWidth === 0)
@@ -390,6 +391,45 @@ fn the_report_opens_in_headless_chromium_without_errors() {
     );
     let log = driver.must("POST", &at("/se/log"), Some(json!({"type": "browser"})));
     let shot = driver.must("GET", &at("/screenshot"), None);
+
+    // A wide parameter table, two anisotropic lobes with a fitted
+    // orientation (14 columns), also fits the page at 1280 px.
+    let wide = dir.path().join("wide");
+    let alu = repo_path("data/alu-ggx/alu-ggx:+30+0.mpc");
+    let args = [
+        "fit",
+        s(&alu),
+        "--model",
+        "plastic2",
+        "--lobes",
+        "2",
+        "--no-export",
+    ];
+    brtf(&[&args[..], &["--out", s(&wide)]].concat(), "").ok();
+    let wide_report = std::fs::canonicalize(wide.join("report.html")).unwrap();
+    driver.must(
+        "POST",
+        &at("/url"),
+        Some(json!({"url": format!("file://{}", s(&wide_report))})),
+    );
+    let wide_state = driver.must(
+        "POST",
+        &at("/execute/sync"),
+        Some(json!({"args": [], "script": "
+            const t = document.getElementById('param-table');
+            return {
+                columns: t ? t.querySelectorAll('thead th').length : -1,
+                overflow: t ? t.getBoundingClientRect().right - document.documentElement.clientWidth : 1e9,
+            };"})),
+    );
+    assert!(
+        wide_state["columns"].as_i64().unwrap() >= 14,
+        "{wide_state}"
+    );
+    assert!(
+        wide_state["overflow"].as_f64().unwrap() <= 0.0,
+        "{wide_state}"
+    );
 
     // The check itself: a page with a missing image and a console error
     // must show up in the log as errors.
@@ -427,6 +467,8 @@ fn the_report_opens_in_headless_chromium_without_errors() {
     assert_eq!(state["title"], json!("alu-ggx: brtf fit report"), "{state}");
     assert_eq!(state["rows"], json!(6), "5 incidences + all: {state}");
     assert!(state["tableHeight"].as_f64().unwrap() > 50.0, "{state}");
+    // At 1280 px the parameter table fits the page: nothing cut off.
+    assert!(state["tableOverflow"].as_f64().unwrap() <= 0.0, "{state}");
     assert_eq!(state["images"], json!(14), "{state}");
     assert_eq!(state["broken"], json!([]), "{state}");
     let png = base64_decode(shot.as_str().expect("a base64 screenshot"));

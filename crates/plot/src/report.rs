@@ -88,6 +88,10 @@ th { background: #f1f1f1; }
 td.l, th.l { text-align: left; }
 tr.global td { background: #f8f8f8; font-weight: 600; }
 .bound { color: #c00; font-weight: 700; }
+.err { color: #555; font-size: 0.88em; }
+#param-table { font-size: 0.86em; }
+#param-table th, #param-table td { padding: 3px 5px; }
+#param-table th { white-space: normal; }
 .warn { background: #fff4e0; border: 1px solid #e0a040; padding: 8px 14px; border-radius: 4px; }
 .warn li { margin: 3px 0; }
 figure { margin: 14px 0 22px; }
@@ -123,15 +127,21 @@ fn figure(out: &mut String, stem: &str, size: (u32, u32), caption: &str) {
 fn param_cell(r: &FitReport, name: &str) -> String {
     match r.params.iter().find(|p| p.name == name) {
         None => "–".into(),
-        Some(p) if p.fixed => format!("{} <span class=\"muted\">(fixed)</span>", fmt6(p.value)),
+        // The value, and what qualifies it on a line of its own, so that
+        // a table of many parameters fits the page.
+        Some(p) if p.fixed => format!("{}<br><span class=\"muted\">(fixed)</span>", fmt6(p.value)),
         Some(p) if p.at_bound => format!(
-            "{} <span class=\"bound\" title=\"ended at a bound of its range: no standard error\">at bound</span>",
+            "{}<br><span class=\"bound\" title=\"ended at a bound of its range: no standard error\">at bound</span>",
             fmt6(p.value)
         ),
         Some(p) => match p.uncertainty() {
-            Some(e) => format!("{} ± {}", fmt6(p.value), fmt_err(e)),
+            Some(e) => format!(
+                "{}<br><span class=\"err\">± {}</span>",
+                fmt6(p.value),
+                fmt_err(e)
+            ),
             None => format!(
-                "{} <span class=\"muted\">(no standard error: {})</span>",
+                "{}<br><span class=\"muted\">(no standard error: {})</span>",
                 fmt6(p.value),
                 p.missing_error_reason().unwrap_or("singular")
             ),
@@ -155,12 +165,23 @@ fn param_table(out: &mut String, result: &FitResult) {
     let Some(first) = result.incidences.first() else {
         return;
     };
-    let names: Vec<&str> = first.params.iter().map(|p| p.name.as_str()).collect();
+    // A grey fit's colour is one number: one column, not three equal ones.
+    let grey = result.config.gray || result.colour_measured() == Some(false);
+    let columns: Vec<(&str, &str)> = first
+        .params
+        .iter()
+        .map(|p| p.name.as_str())
+        .filter(|n| !(grey && matches!(*n, "green" | "blue")))
+        .map(|n| match n {
+            "red" if grey => ("grey (R = G = B)", n),
+            _ => (n, n),
+        })
+        .collect();
     out.push_str(
         "<table id=\"param-table\"><thead><tr><th>θ_in [°]</th><th>φ_in [°]</th><th>points</th>",
     );
-    for n in &names {
-        let _ = write!(out, "<th>{}</th>", esc(n));
+    for (label, _) in &columns {
+        let _ = write!(out, "<th>{}</th>", esc(label));
     }
     out.push_str(
         "<th>E1</th><th>RMS rel.</th><th class=\"l\">termination</th></tr></thead><tbody>\n",
@@ -171,7 +192,7 @@ fn param_table(out: &mut String, result: &FitResult) {
             "<tr class=\"{class}\"><td>{label}</td><td>{phi}</td><td>{}</td>",
             r.n_points
         );
-        for n in &names {
+        for (_, n) in &columns {
             let _ = write!(out, "<td>{}</td>", param_cell(r, n));
         }
         let _ = writeln!(
