@@ -54,9 +54,17 @@ fn the_report_shows_the_table_material_and_provenance() {
         d.result.incidences.len()
     );
     assert_eq!(table.matches("<tr class=\"global\">").count(), 1);
-    for name in ["red", "green", "blue", "spec", "rough", "E1", "RMS rel."] {
+    // A grey fit's colour is one column.
+    let grey = d.result.config.gray || d.result.colour_measured() == Some(false);
+    let colours: &[&str] = if grey {
+        &["grey (R = G = B)"]
+    } else {
+        &["red", "green", "blue"]
+    };
+    for name in colours.iter().chain(&["spec", "rough", "E1", "RMS rel."]) {
         assert!(table.contains(&format!("<th>{name}</th>")), "column {name}");
     }
+    assert_eq!(table.contains("<th>green</th>"), !grey);
     let rough = d.result.incidences[2].value("rough").unwrap();
     assert!(table.contains(&format!("{rough:.6}")));
     // The exported material, escaped, and linked.
