@@ -543,14 +543,7 @@ impl Recipe {
             .zip(removed_by)
             .zip(directions)
             .filter(|((_, removed), _)| removed.is_none())
-            .map(|((s, _), &d)| {
-                let value = if channels == 3 {
-                    brtf_model::luminance(s.values)
-                } else {
-                    s.values[0]
-                };
-                (d, value)
-            })
+            .map(|((s, _), &d)| (d, sample_luminance(s, channels)))
             .filter(|(_, v)| v.is_finite())
             .collect();
         peak_azimuth(&samples, m.incidence.phi_deg)
@@ -620,13 +613,7 @@ impl Recipe {
         let values: Vec<f64> = measurement
             .samples
             .iter()
-            .map(|s| {
-                if channels == 3 {
-                    brtf_model::luminance(s.values)
-                } else {
-                    s.values[0]
-                }
-            })
+            .map(|s| sample_luminance(s, channels))
             .collect();
         let candidates: Vec<bool> = removed_by.iter().map(Option::is_none).collect();
         let found = brtf_gonio::shadow::detect(
@@ -805,5 +792,15 @@ impl PreparedMeasurement {
                 }
             }),
         }
+    }
+}
+
+/// A converted sample's luminance (its one value for grey data): what the
+/// peak and the shadows are judged on.
+fn sample_luminance(s: &brtf_gonio::Sample, channels: usize) -> f64 {
+    if channels == 3 {
+        brtf_model::luminance(s.values)
+    } else {
+        s.values[0]
     }
 }

@@ -104,18 +104,7 @@ fn push_angle(out: &mut Vec<u8>, degrees: f64) {
         out.push(b'-');
     }
     push_integer(out, scaled / 10_000);
-    let mut fraction = scaled % 10_000;
-    if fraction != 0 {
-        let mut digits = 4;
-        while fraction.is_multiple_of(10) {
-            fraction /= 10;
-            digits -= 1;
-        }
-        out.push(b'.');
-        let text = fraction.to_string();
-        out.extend(std::iter::repeat_n(b'0', digits - text.len()));
-        out.extend_from_slice(text.as_bytes());
-    }
+    push_fraction(out, scaled % 10_000, 4);
 }
 
 /// Appends a value with 7 significant digits, as `d.dddddde±x` (trailing
@@ -144,18 +133,7 @@ fn push_value(out: &mut Vec<u8>, x: f64) {
         exponent -= 1;
     }
     out.push(b'0' + (mantissa / 1_000_000) as u8);
-    let mut rest = mantissa % 1_000_000;
-    if rest != 0 {
-        let mut digits = 6;
-        while rest.is_multiple_of(10) {
-            rest /= 10;
-            digits -= 1;
-        }
-        out.push(b'.');
-        let text = rest.to_string();
-        out.extend(std::iter::repeat_n(b'0', digits - text.len()));
-        out.extend_from_slice(text.as_bytes());
-    }
+    push_fraction(out, mantissa % 1_000_000, 6);
     if exponent != 0 {
         out.push(b'e');
         if exponent < 0 {
@@ -163,6 +141,24 @@ fn push_value(out: &mut Vec<u8>, x: f64) {
         }
         push_integer(out, exponent.unsigned_abs() as u64);
     }
+}
+
+/// Appends `.` and the `digits`-digit decimal fraction `fraction` (zero
+/// padded, trailing zeros dropped); nothing when it is 0.
+fn push_fraction(out: &mut Vec<u8>, fraction: u64, digits: usize) {
+    if fraction == 0 {
+        return;
+    }
+    let (mut fraction, mut digits) = (fraction, digits);
+    while fraction.is_multiple_of(10) {
+        fraction /= 10;
+        digits -= 1;
+    }
+    out.push(b'.');
+    let start = out.len();
+    push_integer(out, fraction);
+    let written = out.len() - start;
+    out.splice(start..start, std::iter::repeat_n(b'0', digits - written));
 }
 
 /// Appends the decimal digits of `n`.
