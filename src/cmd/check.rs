@@ -14,16 +14,19 @@ pub(crate) struct CheckArgs {
     /// Rays per detector direction.
     #[arg(long, default_value_t = 128)]
     pub samples: u32,
-    /// Largest number of directions rendered per incidence (evenly subsampled).
-    #[arg(long, default_value_t = 4000)]
-    pub max_directions: usize,
-    /// Beam solid angle in sr [default: the fit's source ω].
+    /// Largest number of directions rendered per incidence (evenly
+    /// subsampled) [default: all, so energy and E1 are over every one].
+    #[arg(long, value_name = "N")]
+    pub max_directions: Option<usize>,
+    /// Beam solid angle in sr [default: the fit's source ω, else the
+    /// file header's aperture, else a 0.5° cone].
     #[arg(long, value_name = "SR")]
     pub source_omega: Option<f64>,
     /// Beam as a full cone apex angle in degrees.
     #[arg(long, value_name = "DEG", conflicts_with = "source_omega")]
     pub source_apex: Option<f64>,
-    /// Detector aperture solid angle in sr [default: a point].
+    /// Detector aperture solid angle in sr [default: the file header's
+    /// aperture, else a 0.75° cone]; 0 is a point.
     #[arg(long, value_name = "SR")]
     pub detector_omega: Option<f64>,
     /// Detector aperture as a full cone apex angle in degrees.
@@ -52,10 +55,7 @@ pub(crate) fn run(args: CheckArgs) -> Result<()> {
         samples: args.samples,
         max_directions: args.max_directions,
         source_omega: args.source_omega.or(apex(args.source_apex)),
-        detector_omega: args
-            .detector_omega
-            .or(apex(args.detector_apex))
-            .unwrap_or(0.0),
+        detector_omega: args.detector_omega.or(apex(args.detector_apex)),
         intermediate: args.intermediate,
         seed: args.seed,
         search_dirs: args.search_dirs.clone(),

@@ -140,8 +140,10 @@ fn check_reports_the_fits_scale_on_raw_signal() {
                 s(&out),
                 "--samples",
                 "2",
-                "--max-directions",
-                "1000000",
+                "--source-omega",
+                "0",
+                "--detector-omega",
+                "0",
             ],
             "",
         )

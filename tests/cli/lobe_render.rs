@@ -100,7 +100,7 @@ fn check_of_a_two_lobe_fit_renders_the_model_and_the_fit_s_misfit() {
     let one = fit_alu(dir.path(), "metal", &[]);
     let two = fit_alu(dir.path(), "metal", &["--lobes", "2"]);
     // Every fitted direction, a point beam and detector (the fit's ω = 0).
-    let every = ["--max-directions", "100000"];
+    let every = ["--source-omega", "0", "--detector-omega", "0"];
     let (_, one_rows) = check(&one, &every);
     let (table, two_rows) = check(&two, &every);
     assert!(table.contains("metal ×2 lobes (θ_in table)"), "{table}");
@@ -157,7 +157,8 @@ fn check_of_a_fitted_orientation_fit_renders_the_model() {
         fit.config.oriented,
         "metal2 fits its orientation on gonio scans"
     );
-    let (table, rows) = check(&oriented, &[]);
+    let point = ["--source-omega", "0", "--detector-omega", "0"];
+    let (table, rows) = check(&oriented, &point);
     assert!(
         table.contains("metal2 (orientation fitted) (θ_in table)"),
         "{table}"

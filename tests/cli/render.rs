@@ -209,7 +209,11 @@ fn check_reports_every_incidence_of_a_fit() {
         .map(String::from),
     );
     brtf(&args, "").ok();
-    let table = brtf_words(&format!("check {} --samples 16", s(&fit_dir))).ok();
+    let table = brtf_words(&format!(
+        "check {} --samples 16 --source-omega 0 --detector-omega 0",
+        s(&fit_dir)
+    ))
+    .ok();
     assert!(
         table.contains("fitted") && table.contains("intermediate"),
         "{table}"
@@ -467,39 +471,85 @@ fn images_match_live_rpict() {
     );
 }
 
-/// A point beam and detector on a point-source fit render the fitted model
-/// itself: `brtf check` says the comparison cannot fail, and says nothing
-/// when the apertures are finite.
+/// `brtf check` renders with the instrument's apertures by default: the
+/// file header's where it states them (brtf synth and render gonio write
+/// them), else a stated typical pgII pair. It renders every fitted
+/// direction, so its energy is over all of them. Only a point beam and
+/// detector asked for on a point-source fit make it a tautology, and it
+/// says so.
 #[test]
-fn a_point_check_of_a_point_fit_says_it_is_a_tautology() {
+fn check_uses_the_instruments_apertures_and_every_direction() {
     let dir = temp_dir();
-    let out = dir.path().join("fit");
+    let fit = |scan: &Path, name: &str| {
+        let out = dir.path().join(name);
+        let args = [
+            "fit",
+            s(scan),
+            "--model",
+            "metal",
+            "--no-plots",
+            "--no-export",
+        ];
+        brtf(&[&args[..], &["--out", s(&out)]].concat(), "").ok();
+        out
+    };
+    // The shipped alu-ggx files state no apertures.
     let scan = crate::common::repo_path("data/alu-ggx/alu-ggx:+30+0.mpc");
-    let args = [
-        "fit",
-        s(&scan),
-        "--model",
-        "metal",
-        "--no-plots",
-        "--no-export",
-    ];
-    brtf(&[&args[..], &["--out", s(&out)]].concat(), "").ok();
-    let point = brtf(&["check", s(&out)], "").ok();
+    let out = fit(&scan, "shipped");
+    let default = brtf(&["check", s(&out), "--samples", "16"], "").ok();
     assert!(
-        point.contains("render − model is 0 by construction"),
-        "{point}"
+        default.contains("beam 0.500° cone") && default.contains("detector 0.750° cone"),
+        "{default}"
     );
-    let finite = brtf(
+    assert!(default.contains("the file states none"), "{default}");
+    assert!(!default.contains("by construction"), "{default}");
+    // Every fitted direction is rendered: n is the fit's sample count.
+    let fitted: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("fit.json")).unwrap()).unwrap();
+    let n_points = fitted["incidences"][0]["n_points"].as_u64().unwrap();
+    let csv = parse_csv_with_text(&std::fs::read_to_string(out.join("check.csv")).unwrap());
+    assert_eq!(csv[0]["n"], n_points.to_string(), "{csv:?}");
+    let capped = brtf(
         &[
             "check",
             s(&out),
-            "--source-omega",
-            "1e-4",
-            "--detector-omega",
-            "1e-4",
+            "--samples",
+            "4",
+            "--max-directions",
+            "500",
         ],
         "",
     )
     .ok();
-    assert!(!finite.contains("by construction"), "{finite}");
+    assert!(capped.contains("--max-directions rendered"), "{capped}");
+    let point = brtf(
+        &[
+            "check",
+            s(&out),
+            "--source-omega",
+            "0",
+            "--detector-omega",
+            "0",
+        ],
+        "",
+    )
+    .ok();
+    assert!(
+        point.contains("render − model is 0 by construction"),
+        "{point}"
+    );
+    // A synthetic scan states the apertures it was made with.
+    let synth = dir.path().join("synth");
+    brtf_words(&format!(
+        "synth --ggx 0.9,0.9,0.9 --theta-in 30 --source-aperture 1 --detector-aperture 0.6 --out {}",
+        s(&synth)
+    ))
+    .ok();
+    let out = fit(&synth.join("synth:+30+0.mpc"), "synth-fit");
+    let stated = brtf(&["check", s(&out), "--samples", "16"], "").ok();
+    assert!(
+        stated.contains("beam 1.000° cone = 2.392e-4 sr (from the file header)")
+            && stated.contains("detector 0.600° cone"),
+        "{stated}"
+    );
 }

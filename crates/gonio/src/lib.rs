@@ -40,6 +40,7 @@
 //! assert!((dsf.samples[0].values[0] - 2.5 * 30f64.to_radians().cos()).abs() < 1e-12);
 //! ```
 
+mod aperture;
 mod convert;
 mod error;
 mod integral;
@@ -54,6 +55,7 @@ pub mod synth;
 mod synth_limits;
 mod write;
 
+pub use aperture::{Apertures, DETECTOR_APERTURE_KEY, SOURCE_APERTURE_KEY};
 pub use convert::{Converted, GRAZING_COS_LIMIT};
 pub use error::{ConvertError, KlemsProblem, ParseErrorKind, ReadError, WriteError};
 pub use integral::{HemisphereIntegral, hemispherical_integral};

@@ -78,3 +78,24 @@ pub fn direction(theta_deg: f64, phi_deg: f64) -> DVec3 {
 pub fn cone_solid_angle(apex_deg: f64) -> f64 {
     2.0 * std::f64::consts::PI * (1.0 - (0.5 * apex_deg.to_radians()).cos())
 }
+
+/// The full apex angle in degrees of a cone of solid angle `omega` sr
+/// (the inverse of [`cone_solid_angle`], for ω in [0, 4π]).
+pub fn cone_apex_deg(omega: f64) -> f64 {
+    let cos_half = (1.0 - omega / (2.0 * std::f64::consts::PI)).clamp(-1.0, 1.0);
+    2.0 * cos_half.acos().to_degrees()
+}
+
+#[cfg(test)]
+mod cone_tests {
+    #[test]
+    fn apex_and_solid_angle_are_inverse() {
+        for apex in [0.0, 0.5, 0.75, 10.0, 90.0, 180.0, 359.0] {
+            let back = super::cone_apex_deg(super::cone_solid_angle(apex));
+            assert!(
+                (back - apex).abs() < 1e-6 * apex.max(1.0),
+                "{apex} → {back}"
+            );
+        }
+    }
+}

@@ -41,12 +41,15 @@ use std::path::{Path, PathBuf};
 pub struct CheckOptions {
     /// Rays per detector direction.
     pub samples: u32,
-    /// Largest number of directions rendered per incidence.
-    pub max_directions: usize,
-    /// Beam solid angle in sr (`None`: the fit's source ω).
+    /// Largest number of directions rendered per incidence (`None`: all
+    /// of them, so that energy and E1 are over every fitted direction).
+    pub max_directions: Option<usize>,
+    /// Beam solid angle in sr (`None`: the fit's source ω when it has one,
+    /// else the file header's aperture, else [`DEFAULT_SOURCE_APERTURE_DEG`]).
     pub source_omega: Option<f64>,
-    /// Detector aperture solid angle in sr.
-    pub detector_omega: f64,
+    /// Detector aperture solid angle in sr (`None`: the file header's,
+    /// else [`DEFAULT_DETECTOR_APERTURE_DEG`]).
+    pub detector_omega: Option<f64>,
     /// Intermediate θ_in rendered between neighbouring fitted incidences.
     pub intermediate: usize,
     /// Random seed.
@@ -59,9 +62,9 @@ impl Default for CheckOptions {
     fn default() -> Self {
         CheckOptions {
             samples: 128,
-            max_directions: 4000,
+            max_directions: None,
             source_omega: None,
-            detector_omega: 0.0,
+            detector_omega: None,
             intermediate: 1,
             seed: 1,
             search_dirs: Vec::new(),
@@ -82,7 +85,7 @@ impl CheckOptions {
             (1.0..=1e6).contains(&samples),
             "1 to 1,000,000",
         )?;
-        let directions = self.max_directions as f64;
+        let directions = self.max_directions.unwrap_or(1) as f64;
         let ok = (1.0..=1e7).contains(&directions);
         OptionError::check("--max-directions", directions, ok, "1 to 10,000,000")?;
         let intermediate = self.intermediate as f64;
@@ -95,12 +98,43 @@ impl CheckOptions {
         let hemisphere = 2.0 * std::f64::consts::PI;
         for (option, omega) in [
             ("--source-omega", self.source_omega.unwrap_or(0.0)),
-            ("--detector-omega", self.detector_omega),
+            ("--detector-omega", self.detector_omega.unwrap_or(0.0)),
         ] {
             let ok = (0.0..=hemisphere).contains(&omega);
             OptionError::check(option, omega, ok, "0 to 2π sr")?;
         }
         Ok(())
+    }
+}
+
+/// The beam aperture (full cone angle, degrees) a check assumes when
+/// neither the user, the fit nor the file gives one: the pgII's, and
+/// `brtf synth`'s default.
+pub const DEFAULT_SOURCE_APERTURE_DEG: f64 = 0.5;
+/// The detector aperture a check assumes when nobody gives one.
+pub const DEFAULT_DETECTOR_APERTURE_DEG: f64 = 0.75;
+
+/// Where an aperture of the check came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ApertureOrigin {
+    /// `--source-omega`/`--detector-omega` (or the apex options).
+    Given,
+    /// The fit's own source ω (`brtf fit --source-omega`).
+    FitModel,
+    /// The measurement file's header.
+    Header,
+    /// The stated default ([`DEFAULT_SOURCE_APERTURE_DEG`], …).
+    Default,
+}
+
+impl std::fmt::Display for ApertureOrigin {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            ApertureOrigin::Given => "given",
+            ApertureOrigin::FitModel => "the fit's source ω",
+            ApertureOrigin::Header => "from the file header",
+            ApertureOrigin::Default => "a typical pgII aperture: the file states none",
+        })
     }
 }
 
@@ -151,6 +185,8 @@ pub struct CheckRow {
     pub kind: RowKind,
     /// Directions rendered.
     pub n: usize,
+    /// Directions the fit used at this incidence (`n` unless subsampled).
+    pub of: usize,
     /// The fit's model-vs-data RMS (fitted incidences).
     pub fit_rms: Option<f64>,
     /// The fit's E1 (fitted incidences; over all its samples).
@@ -191,6 +227,8 @@ pub struct CheckReport {
     pub fit_source_omega: f64,
     /// Detector solid angle, sr.
     pub detector_omega: f64,
+    /// Where the beam's and the detector's apertures came from.
+    pub aperture_origins: [ApertureOrigin; 2],
     /// Rays per direction.
     pub samples: u32,
 }
@@ -202,6 +240,8 @@ struct Directions {
     /// Directions (towards the detector) and their solid angles.
     dirs: Vec<DVec3>,
     weights: Vec<f64>,
+    /// The fitted directions before subsampling.
+    total: usize,
     /// Measured BSDF per direction (÷ the fit's scale), `channels` used.
     measured: Option<Vec<Rgb>>,
     /// E1's weight per direction: the fit's sample weight, times |cos θ_out|
@@ -219,8 +259,33 @@ pub fn check_fit(
     options: &CheckOptions,
 ) -> Result<CheckReport, CheckError> {
     let eval_options = fit.options();
-    let source_omega = options.source_omega.unwrap_or(eval_options.source_omega);
-    let detector_omega = options.detector_omega;
+    let mut fitted = Vec::new();
+    let mut stated = brtf_gonio::Apertures::default();
+    for index in 0..fit.incidences.len() {
+        let (directions, apertures) = fitted_directions(fit, index, dir, options)?;
+        stated.source_deg = stated.source_deg.or(apertures.source_deg);
+        stated.detector_deg = stated.detector_deg.or(apertures.detector_deg);
+        fitted.push(directions);
+    }
+    let fit_source = (eval_options.source_omega > 0.0).then_some(eval_options.source_omega);
+    let cone = |deg: Option<f64>| deg.map(brtf_model::cone_solid_angle);
+    let (source_omega, source_origin) = resolve_aperture([
+        (options.source_omega, ApertureOrigin::Given),
+        (fit_source, ApertureOrigin::FitModel),
+        (cone(stated.source_deg), ApertureOrigin::Header),
+    ])
+    .unwrap_or((
+        brtf_model::cone_solid_angle(DEFAULT_SOURCE_APERTURE_DEG),
+        ApertureOrigin::Default,
+    ));
+    let (detector_omega, detector_origin) = resolve_aperture([
+        (options.detector_omega, ApertureOrigin::Given),
+        (cone(stated.detector_deg), ApertureOrigin::Header),
+    ])
+    .unwrap_or((
+        brtf_model::cone_solid_angle(DEFAULT_DETECTOR_APERTURE_DEG),
+        ApertureOrigin::Default,
+    ));
     let valid = |omega: f64| omega.is_finite() && omega >= 0.0;
     if !valid(source_omega) || !valid(detector_omega) {
         return Err(CheckError::BadSolidAngle);
@@ -244,18 +309,15 @@ pub fn check_fit(
         compare(&shader, material, fit, setup, d, kind)
     };
     let mut rows = Vec::new();
-    let mut fitted = Vec::new();
-    for (index, report) in fit.incidences.iter().enumerate() {
-        let directions = fitted_directions(fit, index, dir, options)?;
+    for (report, directions) in fit.incidences.iter().zip(&fitted) {
         let material = fit
             .composite_at_direction(report.theta_in, report.phi_in, Some(report))
             .ok_or(CheckError::NoMaterial)?;
-        let mut row = render(&material, &directions, RowKind::Fitted);
+        let mut row = render(&material, directions, RowKind::Fitted);
         row.fit_rms = Some(report.rms_rel);
         row.fit_e1 = report.e1;
         row.data_missing = directions.measured.is_none();
         rows.push(row);
-        fitted.push(directions);
     }
     // Intermediate incidences between neighbouring fitted ones.
     if fit.table.is_some() && options.intermediate > 0 {
@@ -274,6 +336,7 @@ pub fn check_fit(
                     phi_in: lo.phi_in,
                     dirs: lo.dirs.clone(),
                     weights: lo.weights.clone(),
+                    total: lo.total,
                     measured: None,
                     e1_weights: Vec::new(),
                     channels: lo.channels,
@@ -293,8 +356,18 @@ pub fn check_fit(
         source_omega,
         fit_source_omega: eval_options.source_omega,
         detector_omega,
+        aperture_origins: [source_origin, detector_origin],
         samples: options.samples.max(1),
     })
+}
+
+/// The first aperture (solid angle, sr) someone gave, with its origin.
+fn resolve_aperture<const N: usize>(
+    candidates: [(Option<f64>, ApertureOrigin); N],
+) -> Option<(f64, ApertureOrigin)> {
+    candidates
+        .into_iter()
+        .find_map(|(omega, origin)| omega.map(|o| (o, origin)))
 }
 
 /// The fit's beam-mask half-angle, degrees (0: none).
@@ -310,13 +383,14 @@ fn beam_mask(fit: &FitResult) -> f64 {
 }
 
 /// The directions and data the fit of incidence `index` used (evenly
-/// subsampled), or a model-only grid when its file is not found.
+/// subsampled), or a model-only grid when its file is not found; with the
+/// apertures the file's header states.
 fn fitted_directions(
     fit: &FitResult,
     index: usize,
     dir: &Path,
     options: &CheckOptions,
-) -> Result<Directions, CheckError> {
+) -> Result<(Directions, brtf_gonio::Apertures), CheckError> {
     let report = &fit.incidences[index];
     let scale = if report.scale > 0.0 {
         report.scale
@@ -333,17 +407,17 @@ fn fitted_directions(
         .and_then(|input| brtf_io::locate_input(&input.path, dir, &options.search_dirs))
         .zip(input);
     let Some((path, input)) = located else {
-        return Ok(model_grid(report, floor, beam_mask(fit)));
+        let grid = model_grid(report, floor, beam_mask(fit));
+        return Ok((grid, brtf_gonio::Apertures::default()));
     };
     let data = |e: String| CheckError::Data(format!("{}: {e}", path.display()));
     let bytes = brtf_io::read_input(&path).map_err(|e| data(e.to_string()))?;
     let prepared = brtf_fit::prepare_input(&fit.recipe, input, &bytes, &path)
         .map_err(|e| data(e.to_string()))?;
     let channels = prepared.channels();
-    let stride = prepared
-        .fitted_count()
-        .div_ceil(options.max_directions.max(1))
-        .max(1);
+    let total = prepared.fitted_count();
+    let cap = options.max_directions.unwrap_or(total).max(1);
+    let stride = total.div_ceil(cap).max(1);
     let samples: Vec<_> = prepared.fitted().step_by(stride).map(|(_, s)| s).collect();
     // The fitter's view of the same samples (in the same order): E1's weights.
     let fitted = prepared.incidence_data();
@@ -360,9 +434,10 @@ fn fitted_directions(
             s.weight.max(0.0) * cosine
         })
         .collect();
-    Ok(Directions {
+    let directions = Directions {
         theta_in: report.theta_in,
         phi_in: report.phi_in,
+        total,
         dirs: samples.iter().map(|s| s.direction()).collect(),
         weights: samples
             .iter()
@@ -380,7 +455,8 @@ fn fitted_directions(
         e1_weights,
         channels,
         floor,
-    })
+    };
+    Ok((directions, prepared.measurement.apertures()))
 }
 
 /// Without data: the model on a 5° × 15° grid of the front hemisphere.
@@ -392,11 +468,13 @@ fn model_grid(report: &FitReport, floor: f64, mask_deg: f64) -> Directions {
         }
     }
     let n = dirs.len();
+    let total = n;
     mask_beam(
         Directions {
             theta_in: report.theta_in,
             phi_in: report.phi_in,
             dirs,
+            total,
             weights: vec![1.0; n],
             measured: None,
             e1_weights: Vec::new(),
@@ -493,6 +571,7 @@ fn compare(
         phi_in: d.phi_in,
         kind,
         n: d.dirs.len(),
+        of: d.total.max(d.dirs.len()),
         fit_rms: None,
         fit_e1: None,
         render_vs_data_e1,
@@ -610,11 +689,30 @@ impl std::fmt::Display for CheckReport {
             );
         }
         f.write_str(&s)?;
+        let [source_origin, detector_origin] = self.aperture_origins;
         writeln!(
             f,
-            "beam {:.3e} sr (fit model: {:.3e} sr), detector {:.3e} sr, {} rays per direction",
-            self.source_omega, self.fit_source_omega, self.detector_omega, self.samples
+            "beam {} ({}), detector {} ({}); fit model's source {:.3e} sr; {} rays per direction",
+            aperture_text(self.source_omega),
+            source_origin,
+            aperture_text(self.detector_omega),
+            detector_origin,
+            self.fit_source_omega,
+            self.samples
         )?;
+        let fitted = || {
+            self.rows
+                .iter()
+                .filter(|r| r.kind == RowKind::Fitted && !r.data_missing)
+        };
+        let (n, of) = fitted().fold((0, 0), |(n, of), r| (n + r.n, of + r.of));
+        if n < of {
+            writeln!(
+                f,
+                "note: --max-directions rendered {n} of the {of} fitted directions: energy and \
+                 E1 are over those only"
+            )?;
+        }
         if self.is_tautology() {
             writeln!(
                 f,
@@ -626,6 +724,15 @@ impl std::fmt::Display for CheckReport {
         }
         Ok(())
     }
+}
+
+/// A solid angle as its cone's full apex angle and in sr.
+fn aperture_text(omega: f64) -> String {
+    if omega <= 0.0 {
+        return "a point".to_string();
+    }
+    let apex = brtf_model::cone_apex_deg(omega);
+    format!("{apex:.3}° cone = {omega:.3e} sr")
 }
 
 impl CheckReport {

@@ -55,7 +55,10 @@ mod scene_spec;
 mod shader;
 
 pub use camera::Camera;
-pub use check::{CheckError, CheckOptions, CheckReport, check_fit};
+pub use check::{
+    ApertureOrigin, CheckError, CheckOptions, CheckReport, DEFAULT_DETECTOR_APERTURE_DEG,
+    DEFAULT_SOURCE_APERTURE_DEG, check_fit,
+};
 pub use frame::Frame;
 pub use gonio::{
     Aperture, GonioError, GonioSetup, GonioValue, VirtualGonio, aperture_solid_angle, cone_average,

@@ -219,6 +219,11 @@ pub fn render_gonio(
             }
             m.sample_name = l.sample_name.clone();
         }
+        let apertures = brtf_gonio::Apertures {
+            source_deg: Some(brtf_model::cone_apex_deg(setup.source_omega)),
+            detector_deg: Some(brtf_model::cone_apex_deg(setup.detector_omega)),
+        };
+        m.header.extend(apertures.header_lines());
         m.header.push(format!(
             "# {GONIO_MARKER}: material {name}, beam {} sr, detector {} sr, {} rays per direction, seed {}",
             setup.source_omega, setup.detector_omega, setup.samples, setup.seed
