@@ -148,7 +148,7 @@ pub(crate) fn bright_centroid(dirs: &[DVec3], values: &[f64]) -> Option<(DVec3, 
 /// The indices of the `count` largest `values`, largest first and in index
 /// order among equals: the head of a stable sort by decreasing value,
 /// found by a selection and a sort of the head alone. `count` ≥ 1.
-fn brightest(values: &[f64], count: usize) -> Vec<usize> {
+pub(crate) fn brightest(values: &[f64], count: usize) -> Vec<usize> {
     let brighter = |a: &usize, b: &usize| values[*b].total_cmp(&values[*a]).then(a.cmp(b));
     let mut order: Vec<usize> = (0..values.len()).collect();
     order.select_nth_unstable_by(count - 1, brighter);

@@ -161,39 +161,81 @@ pub(crate) fn diagnose(
         || fitted_model(prepared, data, &bsdf),
     );
     // Two independent passes over the fitted samples, side by side.
-    let (measured, peak_offset_deg) = rayon::join(
+    let (measured, peak) = rayon::join(
         || measured_sums(prepared, data, &model, scale),
-        || peak_offset(prepared, data, &model),
+        || peak_shape(prepared, data, &model),
     );
+    let peak_offset_deg = peak.as_ref().map(|p| p.offset_deg);
+    let gloss_width_deg = peak.map(|p| p.width_deg);
     // Data's reflectance: measured part ÷ scale, plus the model's rest.
     let complete = |part: Option<(f64, f64)>, model_total: f64| {
         part.map(|(data, model)| model_total + (data - model) / scale)
     };
+    // A free scale's ρ would be the data ÷ a scale that moves with the
+    // residual kind: its energy is given in the file's unit instead.
+    if let crate::Conversion::Raw { unit, .. } = &prepared.conversion
+        && prepared.conversion.is_free_scale()
+    {
+        let side = measured.front.map(|m| (false, m));
+        let raw_energy = side
+            .or(measured.back.map(|m| (true, m)))
+            .map(|(back, (data, model))| crate::RawEnergy {
+                unit: unit.clone(),
+                back,
+                data,
+                model,
+            });
+        return Some(Adequacy {
+            rho_data: None,
+            rho_model,
+            tau_data: None,
+            tau_model,
+            peak_offset_deg,
+            gloss_width_deg,
+            residual_check: None,
+            raw_energy,
+        });
+    }
     Some(Adequacy {
         rho_data: complete(measured.front, rho_model),
         rho_model,
         tau_data: complete(measured.back, tau_model),
         tau_model,
         peak_offset_deg,
+        gloss_width_deg,
         residual_check: None,
+        raw_energy: None,
     })
 }
 
-/// Angle between the centroids of the brightest data and model samples,
-/// over the fitted directions of the hemisphere that holds the brightest
-/// data sample. `None` when the data have no distinct peak (their
-/// brightest samples are less than twice their median). `model` holds the
-/// model's values at the fitted samples ([`fitted_model`]); `data` the
-/// fitter's view of them (their directions).
-fn peak_offset(prepared: &PreparedMeasurement, data: &IncidenceData, model: &[f64]) -> Option<f64> {
+/// The peak of data and model over the fitted directions: the angle
+/// between their directions and their widths. `None` when the data have
+/// no distinct peak (their brightest samples are less than twice their
+/// median). `model` holds the model's values at the fitted samples
+/// ([`fitted_model`]); `data` the fitter's view of them (their directions).
+///
+/// Patch averages (Klems data) are few and wide: the brightest three of
+/// 145 patches jump from one patch to its neighbour on a small change of
+/// value. There both centroids are taken over the same patches (the
+/// brightest of the data's and of the model's), so that a model equal to
+/// the data's averages has its peak exactly there.
+fn peak_shape(
+    prepared: &PreparedMeasurement,
+    data: &IncidenceData,
+    model: &[f64],
+) -> Option<PeakShape> {
     let channels = prepared.channels();
-    let (dirs, (data_values, model_values)): (Vec<DVec3>, (Vec<f64>, Vec<f64>)) = data
-        .samples
-        .iter()
-        .zip(model)
-        .map(|(s, &f)| (s.view, (luminance(s.value, channels), f)))
-        .filter(|(_, (y, _))| y.is_finite())
-        .unzip();
+    let mut dirs = Vec::with_capacity(model.len());
+    let (mut data_values, mut model_values, mut omegas) = (Vec::new(), Vec::new(), Vec::new());
+    for ((s, &f), (_, sample)) in data.samples.iter().zip(model).zip(prepared.fitted()) {
+        let y = luminance(s.value, channels);
+        if y.is_finite() {
+            dirs.push(s.view);
+            data_values.push(y);
+            model_values.push(f);
+            omegas.push(sample.solid_angle_sr.unwrap_or(0.0));
+        }
+    }
     let ((data_peak, contrast), (model_peak, _)) = match rayon::join(
         || bright_centroid(&dirs, &data_values),
         || bright_centroid(&dirs, &model_values),
@@ -204,13 +246,72 @@ fn peak_offset(prepared: &PreparedMeasurement, data: &IncidenceData, model: &[f6
     if contrast < 2.0 {
         return None;
     }
-    Some(
-        data_peak
-            .dot(model_peak)
-            .clamp(-1.0, 1.0)
-            .acos()
-            .to_degrees(),
-    )
+    let (data_peak, model_peak) = if prepared.patch_pairs.is_some() {
+        let mut common = brightest_indices(&data_values);
+        common.extend(brightest_indices(&model_values));
+        let centroid = |values: &[f64]| -> DVec3 {
+            common
+                .iter()
+                .map(|&i| dirs[i] * values[i].max(0.0))
+                .sum::<DVec3>()
+                .normalize_or_zero()
+        };
+        (centroid(&data_values), centroid(&model_values))
+    } else {
+        (data_peak, model_peak)
+    };
+    let offset_deg = data_peak
+        .dot(model_peak)
+        .clamp(-1.0, 1.0)
+        .acos()
+        .to_degrees();
+    let width_deg = [
+        half_max_width_deg(&data_values, &omegas),
+        half_max_width_deg(&model_values, &omegas),
+    ];
+    Some(PeakShape {
+        offset_deg,
+        width_deg,
+    })
+}
+
+/// Where a peak is and how wide, data against model.
+struct PeakShape {
+    /// Angle between the two peak directions, degrees.
+    offset_deg: f64,
+    /// [data, model] half-maximum widths ([`half_max_width_deg`]).
+    width_deg: [f64; 2],
+}
+
+/// The indices of the brightest [`crate::align::PEAK_FRACTION`] of
+/// `values` (at least three).
+fn brightest_indices(values: &[f64]) -> Vec<usize> {
+    let count = ((values.len() as f64 * crate::align::PEAK_FRACTION).ceil() as usize)
+        .clamp(3.min(values.len()), values.len());
+    crate::align::brightest(values, count.max(1))
+}
+
+/// A peak's width: the full apex angle of the cone whose solid angle is
+/// that of the samples above half the peak's height over the median (the
+/// peak: the mean of the brightest samples). The measure of gloss width
+/// that needs no model: data and model are judged alike.
+fn half_max_width_deg(values: &[f64], omegas: &[f64]) -> f64 {
+    if values.is_empty() {
+        return 0.0;
+    }
+    let top = brightest_indices(values);
+    let peak = top.iter().map(|&i| values[i]).sum::<f64>() / top.len() as f64;
+    let mut sorted = values.to_vec();
+    let mid = sorted.len() / 2;
+    let median = *sorted.select_nth_unstable_by(mid, f64::total_cmp).1;
+    let half = median + 0.5 * (peak - median);
+    let omega: f64 = values
+        .iter()
+        .zip(omegas)
+        .filter(|(v, _)| **v >= half)
+        .map(|(_, w)| w)
+        .sum();
+    brtf_model::cone_apex_deg(omega)
 }
 
 /// The residual kind of the second fit: log for absolute residuals,
@@ -260,11 +361,12 @@ pub(crate) fn warnings(a: &Adequacy) -> Vec<crate::FitWarning> {
     if let Some(ratio) = a.energy_ratio()
         && !(1.0 / (1.0 + ENERGY_TOLERANCE)..=1.0 + ENERGY_TOLERANCE).contains(&ratio)
     {
-        let (data, model) = match a.rho_data {
-            Some(d) if a.rho_model > 0.0 => (d, a.rho_model),
-            _ => (a.tau_data.unwrap_or(f64::NAN), a.tau_model),
-        };
-        warnings.push(crate::FitWarning::EnergyMismatch { data, model });
+        let figure = a.energy().expect("a ratio has its figure");
+        warnings.push(crate::FitWarning::EnergyMismatch {
+            data: figure.data,
+            model: figure.model,
+            unit: figure.unit,
+        });
     }
     if let Some(offset) = a.peak_offset_deg
         && offset > PEAK_TOLERANCE_DEG

@@ -58,9 +58,11 @@ mod table;
 mod tests;
 mod uncertainty;
 mod validate;
+mod verdict;
 
 pub use adequacy::{
-    Adequacy, ENERGY_TOLERANCE, PEAK_TOLERANCE_DEG, RESIDUAL_KIND_TOLERANCE, ResidualCheck,
+    Adequacy, ENERGY_TOLERANCE, EnergyFigure, GLOSS_WIDTH_TOLERANCE, PEAK_TOLERANCE_DEG,
+    RESIDUAL_KIND_TOLERANCE, RawEnergy, ResidualCheck,
 };
 pub use align::{AzimuthRule, MAX_TURN_DEG, MIN_ARC_DEG};
 pub use auto::{AutoChoice, CandidateRecord, FOLDS, MARGIN_POINTS, MARGIN_RELATIVE};
@@ -85,3 +87,4 @@ pub use set::{
 };
 pub use summary::{summary, warning_lines};
 pub use table::{AzimuthRing, Interpolation, ParamTable, TableError, TableLookup, azimuth_from_u};
+pub use verdict::{Aspect, Trust, Verdict};

@@ -266,6 +266,10 @@ pub enum FitWarning {
         data: f64,
         /// The model's.
         model: f64,
+        /// A free scale's unit (`uA·sr`): then both are sums over the
+        /// measured directions in the file's unit, not ρ/τ.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        unit: Option<String>,
     },
     /// The model's peak is more than 5° from the data's.
     PeakOffset {
@@ -335,10 +339,24 @@ impl std::fmt::Display for FitWarning {
                 "the robust reweighting did not settle in {rounds} rounds: the parameters are \
                  not yet the robust loss's minimum"
             ),
-            FitWarning::EnergyMismatch { data, model } => write!(
+            FitWarning::EnergyMismatch {
+                data,
+                model,
+                unit: None,
+            } => write!(
                 f,
                 "the model does not carry the data's energy: data ρ_dh {data:.4}, model {model:.4} \
                  ({:+.1}%); the model cannot describe this sample's scattering",
+                100.0 * (model / data - 1.0)
+            ),
+            FitWarning::EnergyMismatch {
+                data,
+                model,
+                unit: Some(unit),
+            } => write!(
+                f,
+                "the fitted shape does not carry the data's energy: over the measured directions \
+                 data {data:.4} {unit}, model × scale {model:.4} {unit} ({:+.1}%)",
                 100.0 * (model / data - 1.0)
             ),
             FitWarning::PeakOffset { degrees } => write!(

@@ -104,6 +104,13 @@ pub fn summary(result: &FitResult, out: &Path) -> String {
             let _ = writeln!(s, "  {w}");
         }
     }
+    if !result.incidences.is_empty() {
+        let verdict = result.verdict();
+        let _ = writeln!(s, "\nverdict: {}", verdict.headline());
+        for line in verdict.lines() {
+            let _ = writeln!(s, "  {line}");
+        }
+    }
     if let Some(g) = &result.global {
         let shape = result.config.shape();
         let args: Vec<String> = g.material_args.iter().map(|a| format!("{a:.6}")).collect();
@@ -330,11 +337,13 @@ fn adequacy_table(s: &mut String, result: &FitResult) {
             |v| format!("{v:>width$.precision$}"),
         )
     };
+    let raw_unit = rows
+        .iter()
+        .find_map(|(_, a)| a.energy().and_then(|e| e.unit));
     for (r, a) in rows {
-        let (data, model) = match a.rho_data {
-            Some(d) => (Some(d), a.rho_model),
-            None => (a.tau_data, a.tau_model),
-        };
+        let figure = a.energy();
+        let data = figure.as_ref().map(|e| e.data);
+        let model = figure.as_ref().map_or(a.rho_model, |e| e.model);
         let check = a.residual_check.as_ref().map_or_else(String::new, |c| {
             format!(
                 "{:?}: {} {:.4} → {:.4} ({:.0}%)",
@@ -353,6 +362,13 @@ fn adequacy_table(s: &mut String, result: &FitResult) {
             model,
             opt(a.energy_ratio(), 7, 3),
             opt(a.peak_offset_deg, 6, 1),
+        );
+    }
+    if let Some(unit) = raw_unit {
+        let _ = writeln!(
+            s,
+            "  free scale: data and model are Σ Ω |cos θ_out| y over the measured directions, in \
+             {unit} (the data's never depend on the fit; give --rho or a beam integral for ρ_dh)"
         );
     }
 }

@@ -24,6 +24,8 @@ fn adequate() -> Adequacy {
         tau_model: 0.0,
         peak_offset_deg: Some(1.0),
         residual_check: None,
+        raw_energy: None,
+        gloss_width_deg: None,
     }
 }
 
@@ -69,7 +71,8 @@ fn an_energy_ratio_outside_one_over_one_plus_t_to_one_plus_t_warns() {
                 w,
                 vec![FitWarning::EnergyMismatch {
                     data: 0.8 * ratio,
-                    model: 0.8
+                    model: 0.8,
+                    unit: None,
                 }],
                 "ratio {ratio}"
             );
@@ -95,7 +98,8 @@ fn without_reflection_the_energy_is_the_transmissions() {
             warnings(&a),
             vec![FitWarning::EnergyMismatch {
                 data: 0.3,
-                model: 0.2
+                model: 0.2,
+                unit: None,
             }]
         );
     }
@@ -301,7 +305,8 @@ fn a_lambertian_measured_twenty_percent_high_over_theta_60_gives_the_expected_ra
         warnings(&a),
         vec![FitWarning::EnergyMismatch {
             data: a.rho_data.unwrap(),
-            model: a.rho_model
+            model: a.rho_model,
+            unit: None,
         }]
     );
     // Raw data of a free scale s: the measured part is divided by s, so
