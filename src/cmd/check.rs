@@ -14,19 +14,16 @@ pub(crate) struct CheckArgs {
     /// Rays per detector direction.
     #[arg(long, default_value_t = 128)]
     pub samples: u32,
-    /// Largest number of directions rendered per incidence (evenly
-    /// subsampled) [default: all, so energy and E1 are over every one].
+    /// Most directions rendered per incidence, evenly subsampled [default: all].
     #[arg(long, value_name = "N")]
     pub max_directions: Option<usize>,
-    /// Beam solid angle in sr [default: the fit's source ω, else the
-    /// file header's aperture, else a 0.5° cone].
+    /// Beam solid angle in sr [default: the fit's source ω, the header's, or 0.5°].
     #[arg(long, value_name = "SR")]
     pub source_omega: Option<f64>,
     /// Beam as a full cone apex angle in degrees.
     #[arg(long, value_name = "DEG", conflicts_with = "source_omega")]
     pub source_apex: Option<f64>,
-    /// Detector aperture solid angle in sr [default: the file header's
-    /// aperture, else a 0.75° cone]; 0 is a point.
+    /// Detector solid angle in sr [default: the file header's, or 0.75°]; 0: a point.
     #[arg(long, value_name = "SR")]
     pub detector_omega: Option<f64>,
     /// Detector aperture as a full cone apex angle in degrees.

@@ -33,6 +33,9 @@ pub(crate) struct ExportArgs {
     /// No preview scene.
     #[arg(long)]
     pub no_preview: bool,
+    /// A colour measured elsewhere: its chromaticity at the fitted luminance.
+    #[arg(long, value_name = "R,G,B", value_parser = brtf_model::parse_rgb, conflicts_with = "klems")]
+    pub colour: Option<[f64; 3]>,
     #[command(flatten)]
     pub klems: KlemsArgs,
 }
@@ -56,14 +59,13 @@ pub(crate) struct KlemsArgs {
     #[arg(long, value_name = "N", requires = "klems",
           default_value_t = brtf_gonio::klems::DEFAULT_SAMPLES)]
     pub klems_samples: usize,
-    /// Add a Solar band: `visible` repeats the Visible values (said in the
-    /// header as an assumption), or a Radiance file with a material of the
-    /// solar properties.
+    /// Add a Solar band: `visible` repeats the Visible values (the header says
+    /// so), or a Radiance file with a material of the solar properties.
     #[arg(long, value_name = "visible|S.rad", requires = "klems")]
     pub solar: Option<String>,
     /// Add CIE-X and CIE-Z bands (colour).
     #[arg(long, requires = "klems")]
-    pub colour: bool,
+    pub xyz_bands: bool,
     /// With --klems --material: also write `<name>-bsdf2klems.cal`, the
     /// material's BSDF (CIE Y) as the six-argument function
     /// `bsdf2klems -f` takes, for an independent Klems file from Radiance.
@@ -90,6 +92,7 @@ pub(crate) fn run(args: ExportArgs) -> Result<()> {
         at: args.at,
         theta_dependent: !args.static_only,
         preview: !args.no_preview,
+        colour: args.colour,
     };
     options.validate()?;
     let result = brtf_workflow::read_fit(dir)?;
@@ -104,7 +107,7 @@ fn run_klems(args: &ExportArgs, basis: BasisSize) -> Result<()> {
     options.basis = basis.basis();
     options.sampling.samples = k.klems_samples;
     options.solar = brtf_workflow::solar_band(k.solar.as_deref())?;
-    options.colour = k.colour;
+    options.colour = k.xyz_bands;
     options.manufacturer = k.manufacturer.clone();
     options.thickness_mm = k.thickness;
     options.device_type = k.device_type.clone();

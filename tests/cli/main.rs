@@ -45,3 +45,4 @@ mod rtrace;
 mod safety;
 mod shadow;
 mod speed;
+mod verdict;

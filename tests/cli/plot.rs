@@ -142,7 +142,9 @@ fn plotting_a_120k_point_scan_takes_under_a_second() {
         let started = Instant::now();
         let out = brtf(&["plot", s(&fit)], "").ok();
         best = best.min(started.elapsed().as_secs_f64());
-        assert!(out.contains("13 files"), "{out}");
+        // One incidence: its map and cut (SVG, PNG) and the report; no
+        // chart over θ_in.
+        assert!(out.contains("5 files"), "{out}");
     }
     eprintln!(
         "brtf plot of a {}-point incidence: {best:.3} s (best of 5)",
@@ -150,6 +152,7 @@ fn plotting_a_120k_point_scan_takes_under_a_second() {
     );
     assert!(best < 1.0, "plotting took {best:.3} s");
     assert!(fit.join("plots/map-t26.8421.png").is_file());
+    assert!(!fit.join("plots/params.png").exists());
 }
 
 /// A program on `PATH`.
@@ -384,6 +387,7 @@ fn the_report_opens_in_headless_chromium_without_errors() {
                 tableHeight: t ? t.getBoundingClientRect().height : 0,
                 tableOverflow: t ? t.getBoundingClientRect().right - document.documentElement.clientWidth : 1e9,
                 images: document.images.length,
+                note: document.getElementById('theta-note') !== null,
                 broken: Array.from(document.images)
                     .filter(i => !i.complete || i.naturalWidth === 0)
                     .map(i => i.getAttribute('src')),
@@ -393,7 +397,8 @@ fn the_report_opens_in_headless_chromium_without_errors() {
     let shot = driver.must("GET", &at("/screenshot"), None);
 
     // A wide parameter table, two anisotropic lobes with a fitted
-    // orientation (14 columns), also fits the page at 1280 px.
+    // orientation (14 columns), also fits the page at 1280 px. It is a fit
+    // of one incidence: no chart over θ_in, one line in their place.
     let wide = dir.path().join("wide");
     let alu = repo_path("data/alu-ggx/alu-ggx:+30+0.mpc");
     let args = [
@@ -417,11 +422,40 @@ fn the_report_opens_in_headless_chromium_without_errors() {
         &at("/execute/sync"),
         Some(json!({"args": [], "script": "
             const t = document.getElementById('param-table');
+            const note = document.getElementById('theta-note');
+            const theta = document.getElementById('theta');
             return {
                 columns: t ? t.querySelectorAll('thead th').length : -1,
                 overflow: t ? t.getBoundingClientRect().right - document.documentElement.clientWidth : 1e9,
+                images: Array.from(document.images).map(i => i.getAttribute('src')),
+                broken: Array.from(document.images)
+                    .filter(i => !i.complete || i.naturalWidth === 0)
+                    .map(i => i.getAttribute('src')),
+                thetaImages: theta ? theta.querySelectorAll('img').length : -1,
+                note: note ? note.innerText : null,
+                noteShown: note ? note.getBoundingClientRect().height > 0 : false,
             };"})),
     );
+    let mut wide_images: Vec<&str> = wide_state["images"]
+        .as_array()
+        .expect("the images")
+        .iter()
+        .map(|v| v.as_str().unwrap())
+        .collect();
+    wide_images.sort();
+    assert_eq!(
+        wide_images,
+        ["plots/cut-t30.svg", "plots/map-t30.svg"],
+        "{wide_state}"
+    );
+    assert_eq!(wide_state["broken"], json!([]), "{wide_state}");
+    assert_eq!(wide_state["thetaImages"], json!(0), "{wide_state}");
+    assert_eq!(
+        wide_state["note"],
+        json!("One incidence fitted: the charts over θ_in need two or more."),
+        "{wide_state}"
+    );
+    assert_eq!(wide_state["noteShown"], json!(true), "{wide_state}");
     assert!(
         wide_state["columns"].as_i64().unwrap() >= 14,
         "{wide_state}"
@@ -470,6 +504,7 @@ fn the_report_opens_in_headless_chromium_without_errors() {
     // At 1280 px the parameter table fits the page: nothing cut off.
     assert!(state["tableOverflow"].as_f64().unwrap() <= 0.0, "{state}");
     assert_eq!(state["images"], json!(14), "{state}");
+    assert_eq!(state["note"], json!(false), "five incidences: {state}");
     assert_eq!(state["broken"], json!([]), "{state}");
     let png = base64_decode(shot.as_str().expect("a base64 screenshot"));
     assert!(png.starts_with(b"\x89PNG\r\n\x1a\n") && png.len() > 10_000);

@@ -32,6 +32,7 @@
 mod adequacy;
 mod align;
 mod auto;
+mod colour;
 mod config;
 mod data;
 mod diagnose;
@@ -67,6 +68,7 @@ pub use adequacy::{
 pub use align::{AzimuthRule, MAX_TURN_DEG, MIN_ARC_DEG};
 pub use auto::{AutoChoice, CandidateRecord, FOLDS, MARGIN_POINTS, MARGIN_RELATIVE};
 pub use brtf_gonio::Gate;
+pub use colour::ColourError;
 pub use config::{FitConfig, FitError, KnownReflectance, ModelChoice, RobustLoss};
 pub use data::{FitSample, GateCount, IncidenceData, PatchPairs, Weighting};
 pub use fitter::{fit_global, fit_incidence};

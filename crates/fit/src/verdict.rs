@@ -242,7 +242,7 @@ impl Verdict {
                 short(lo)
             ),
             n => format!(
-                "valid for θ_in {}–{}° ({n} incidences; outside, the end incidence's material holds)",
+                "valid for θ_in {}–{}° ({n} incidences fitted; beyond them, extrapolation)",
                 short(lo),
                 short(hi)
             ),

@@ -79,6 +79,25 @@ pub fn cone_solid_angle(apex_deg: f64) -> f64 {
     2.0 * std::f64::consts::PI * (1.0 - (0.5 * apex_deg.to_radians()).cos())
 }
 
+/// Three numbers `R,G,B` (a command-line colour).
+pub fn parse_rgb(text: &str) -> Result<[f64; 3], String> {
+    let values: Vec<f64> = text
+        .split(',')
+        .map(|c| {
+            c.trim()
+                .parse::<f64>()
+                .map_err(|_| format!("{text}: not a number"))
+        })
+        .collect::<Result<_, _>>()?;
+    let rgb: [f64; 3] = values
+        .try_into()
+        .map_err(|_| format!("{text}: give three numbers R,G,B"))?;
+    let valid = rgb.iter().all(|c| c.is_finite() && *c >= 0.0) && luminance(rgb) > 0.0;
+    valid
+        .then_some(rgb)
+        .ok_or_else(|| format!("{text}: give three values ≥ 0, not all 0"))
+}
+
 /// The full apex angle in degrees of a cone of solid angle `omega` sr
 /// (the inverse of [`cone_solid_angle`], for ω in [0, 4π]).
 pub fn cone_apex_deg(omega: f64) -> f64 {

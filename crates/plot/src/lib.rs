@@ -14,6 +14,9 @@
 //! | `rms` | the error of every incidence's fit |
 //! | `cuts` | every incidence's cut in one chart |
 //!
+//! A fit of one incidence has no `params`, `rho`, `rms` or `cuts`: each
+//! would show that incidence alone. The report says so in their place.
+//!
 //! `<tag>` is `t<θ_in>` (e.g. `t30`, `t26.8421`), with `-p<φ_in>` when
 //! φ_in ≠ 0 or θ_in repeats. Then it writes `<fit folder>/report.html`,
 //! which shows all of them with the parameter table, the exported
@@ -305,7 +308,7 @@ fn render_and_write(
 /// `<dir>/report.html` (see the crate docs). `dir` is the fit folder: the
 /// report embeds the `.rad` files found there and links `fit.json` and
 /// `params.csv`. Plots of an earlier run that this run did not draw again
-/// (`map-*`, `cut-*`) are removed.
+/// (`map-*`, `cut-*`, the charts over θ_in) are removed.
 pub fn write_plots(
     dir: &Path,
     result: &FitResult,
@@ -408,96 +411,44 @@ fn plot(
     for inc in &incs {
         let report = &result.incidences[inc.index];
         let label = charts::incidence_label(inc.theta_in, inc.phi_in);
-        jobs.push(Job::Map(MapChart::new(
-            inc,
-            format!("{name} ({model}), {label}: model ÷ data over the hemisphere"),
-            ratio,
-            report.rms_rel,
-        )));
-        jobs.push(Job::Cut(CutChart {
-            inc,
-            title: format!("{name} ({model}), {label}: cut through the plane of incidence"),
-            tolerance: options.plane_tolerance_deg,
-        }));
-    }
-    let params = ParamsChart {
-        result,
-        unit: unit.clone(),
-        title: format!("{name} ({model}): fitted parameters over θ_in"),
-    };
-    let rho = RhoChart {
-        result,
-        incs: by_index.clone(),
-        integrals: Default::default(),
-        unit: unit.clone(),
-        channels,
-        title: format!("{name} ({model}): hemispherical reflectance, data against model"),
-    };
-    let rms = RmsChart {
-        result,
-        medians,
-        title: format!("{name} ({model}): error of each incidence's fit"),
-    };
-    let mut overview = vec![
-        (
-            params.name(),
-            params.size(),
-            "Fitted parameters over θ_in: dots with ±1 standard-error bars per incidence, the θ_in \
-             interpolation the exported material uses, and the all-incidence fit (dashed)."
-                .to_string(),
-        ),
-        (
-            rho.name(),
-            rho.size(),
-            "Directional-hemispherical reflectance: the data summed over the fitted samples, the model \
-             over the same samples, and the model over the whole hemisphere."
-                .to_string(),
-        ),
-        (
-            rms.name(),
-            rms.size(),
-            "Error per incidence: the fit's RMS relative error and the median |model ÷ data − 1|."
-                .to_string(),
-        ),
-    ];
-    jobs.push(Job::Params(params));
-    if AzimuthChart::applies(result) {
-        let azimuth = AzimuthChart {
-            result,
-            title: format!("{name} ({model}): fitted parameters over φ_in, one line per θ_in ring"),
-        };
-        overview.insert(
-            1,
-            (
-                azimuth.name(),
-                azimuth.size(),
-                "The parameters follow φ_in too: each θ_in ring's incidences (dots) and the linear, \
-                 periodic interpolation between them that the exports use (lines)."
-                    .to_string(),
-            ),
+        let mut map = MapChart::new(inc, String::new(), ratio, report.rms_rel);
+        map.title = title(
+            &map,
+            name,
+            format!(" ({model}), {label}: model ÷ data over the hemisphere"),
         );
-        jobs.push(Job::Azimuth(azimuth));
-    }
-    jobs.push(Job::Rho(rho));
-    jobs.push(Job::Rms(rms));
-    if !incs.is_empty() {
-        let cuts = CutsChart {
-            incs: incs.clone(),
-            title: format!(
-                "{name} ({model}): in-plane cuts of every incidence (dots: data, lines: model)"
-            ),
+        jobs.push(Job::Map(map));
+        let mut cut = CutChart {
+            inc,
+            title: String::new(),
             tolerance: options.plane_tolerance_deg,
         };
-        overview.push((
-            cuts.name(),
-            cuts.size(),
-            "Every incidence's cut through its plane of incidence: fitted data near the plane (dots) and the \
-             fitted model (lines), one colour per incidence."
-                .to_string(),
-        ));
-        jobs.push(Job::Cuts(cuts));
+        cut.title = title(
+            &cut,
+            name,
+            format!(" ({model}), {label}: cut through the plane of incidence"),
+        );
+        jobs.push(Job::Cut(cut));
     }
-
+    // With one incidence every chart over θ_in would hold one point, and
+    // the chart of all cuts would repeat its cut: none is drawn, and the
+    // report says why.
+    let mut overview = Vec::new();
+    if result.incidences.len() >= 2 {
+        overview_charts(
+            &mut jobs,
+            &mut overview,
+            Overview {
+                result,
+                incs: &incs,
+                by_index: &by_index,
+                unit,
+                channels,
+                medians,
+                tolerance: options.plane_tolerance_deg,
+            },
+        );
+    }
     let entries = result
         .incidences
         .iter()
@@ -571,7 +522,146 @@ fn plot(
     })
 }
 
-/// Removes `map-*` and `cut-*` plots that this run did not write.
+/// `name` then `rest` as `chart`'s title, the name shortened to fit the
+/// chart's width ([`charts::fit_title`]).
+fn title(chart: &impl Chart, name: &str, rest: String) -> String {
+    charts::fit_title(name, &rest, chart.size().0)
+}
+
+/// What the charts over θ_in (and the chart of all cuts) are drawn from.
+struct Overview<'a, 'b> {
+    result: &'a FitResult,
+    /// The incidences with data.
+    incs: &'b [&'a Incidence],
+    /// Incidence k's data, if read.
+    by_index: &'b [Option<&'a Incidence>],
+    unit: DataUnit,
+    channels: usize,
+    /// Median |model ÷ data − 1| per incidence.
+    medians: Vec<Option<f64>>,
+    /// Forced plane tolerance of the cuts, degrees.
+    tolerance: Option<f64>,
+}
+
+/// Adds the charts over θ_in (and φ_in), and the chart of all cuts, to
+/// `jobs`, and their `(stem, size, caption)` to `overview`, in the
+/// report's order.
+fn overview_charts<'a>(
+    jobs: &mut Vec<Job<'a>>,
+    overview: &mut Vec<(String, (u32, u32), String)>,
+    o: Overview<'a, '_>,
+) {
+    let result = o.result;
+    let name = &result.name;
+    let model = result.config.shape().label();
+    let mut params = ParamsChart {
+        result,
+        unit: o.unit.clone(),
+        title: String::new(),
+    };
+    params.title = title(
+        &params,
+        name,
+        format!(" ({model}): fitted parameters over θ_in"),
+    );
+    let mut rho = RhoChart {
+        result,
+        incs: o.by_index.to_vec(),
+        integrals: Default::default(),
+        unit: o.unit,
+        channels: o.channels,
+        title: String::new(),
+    };
+    rho.title = title(
+        &rho,
+        name,
+        format!(" ({model}): hemispherical reflectance, data against model"),
+    );
+    let mut rms = RmsChart {
+        result,
+        medians: o.medians,
+        title: String::new(),
+    };
+    rms.title = title(
+        &rms,
+        name,
+        format!(" ({model}): error of each incidence's fit"),
+    );
+    overview.extend([
+        (
+            params.name(),
+            params.size(),
+            "Fitted parameters over θ_in: dots with ±1 standard-error bars per incidence, the θ_in \
+             interpolation the exported material uses, and the all-incidence fit (dashed)."
+                .to_string(),
+        ),
+        (
+            rho.name(),
+            rho.size(),
+            "Directional-hemispherical reflectance: the data summed over the fitted samples, the model \
+             over the same samples, and the model over the whole hemisphere."
+                .to_string(),
+        ),
+        (
+            rms.name(),
+            rms.size(),
+            "Error per incidence: the fit's RMS relative error and the median |model ÷ data − 1|."
+                .to_string(),
+        ),
+    ]);
+    jobs.push(Job::Params(params));
+    if AzimuthChart::applies(result) {
+        let mut azimuth = AzimuthChart {
+            result,
+            title: String::new(),
+        };
+        azimuth.title = title(
+            &azimuth,
+            name,
+            format!(" ({model}): fitted parameters over φ_in, one line per θ_in ring"),
+        );
+        overview.insert(
+            1,
+            (
+                azimuth.name(),
+                azimuth.size(),
+                "The parameters follow φ_in too: each θ_in ring's incidences (dots) and the linear, \
+                 periodic interpolation between them that the exports use (lines)."
+                    .to_string(),
+            ),
+        );
+        jobs.push(Job::Azimuth(azimuth));
+    }
+    jobs.push(Job::Rho(rho));
+    jobs.push(Job::Rms(rms));
+    if !o.incs.is_empty() {
+        let mut cuts = CutsChart {
+            incs: o.incs.to_vec(),
+            title: String::new(),
+            tolerance: o.tolerance,
+        };
+        cuts.title = title(
+            &cuts,
+            name,
+            format!(" ({model}): in-plane cuts of every incidence (dots: data, lines: model)"),
+        );
+        overview.push((
+            cuts.name(),
+            cuts.size(),
+            "Every incidence's cut through its plane of incidence: fitted data near the plane (dots) and the \
+             fitted model (lines), one colour per incidence."
+                .to_string(),
+        ));
+        jobs.push(Job::Cuts(cuts));
+    }
+}
+
+/// The charts drawn once per fit (not per incidence), by file stem.
+const OVERVIEW_STEMS: [&str; 5] = ["params", "params-phi", "rho", "rms", "cuts"];
+
+/// Removes plots that this run did not write: `map-*` and `cut-*` of
+/// incidences no longer in the fit, and the charts of the whole fit it
+/// did not draw (a fit of one incidence, a table that does not follow φ_in).
 fn remove_stale(plots: &Path, written: &[PathBuf]) {
     let Ok(entries) = std::fs::read_dir(plots) else {
         return;
@@ -579,8 +669,14 @@ fn remove_stale(plots: &Path, written: &[PathBuf]) {
     for e in entries.filter_map(|e| e.ok()) {
         let path = e.path();
         let name = e.file_name().to_string_lossy().into_owned();
-        let ours = (name.starts_with("map-") || name.starts_with("cut-"))
-            && (name.ends_with(".svg") || name.ends_with(".png"));
+        let Some(stem) = name
+            .strip_suffix(".svg")
+            .or_else(|| name.strip_suffix(".png"))
+        else {
+            continue;
+        };
+        let ours =
+            stem.starts_with("map-") || stem.starts_with("cut-") || OVERVIEW_STEMS.contains(&stem);
         if ours && !written.contains(&path) {
             let _ = std::fs::remove_file(&path);
         }

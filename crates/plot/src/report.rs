@@ -31,7 +31,7 @@ pub(crate) struct ReportInput<'a> {
     pub dir: &'a Path,
     /// The fit.
     pub result: &'a FitResult,
-    /// Charts over θ_in: `(stem, size, caption)`.
+    /// Charts over θ_in: `(stem, size, caption)`; none for one incidence.
     pub overview: Vec<(String, (u32, u32), String)>,
     /// One entry per incidence.
     pub incidences: Vec<IncidenceEntry<'a>>,
@@ -94,6 +94,8 @@ tr.global td { background: #f8f8f8; font-weight: 600; }
 #param-table th { white-space: normal; }
 .warn { background: #fff4e0; border: 1px solid #e0a040; padding: 8px 14px; border-radius: 4px; }
 .warn li { margin: 3px 0; }
+.verdict { background: #eef5ff; border: 1px solid #7a9cd0; padding: 8px 14px; border-radius: 4px; margin-bottom: 10px; }
+.verdict li { margin: 3px 0; }
 figure { margin: 14px 0 22px; }
 figure img { max-width: 100%; height: auto; border: 1px solid #e4e4e4; }
 figcaption { font-size: 0.9em; color: #333; margin-top: 4px; }
@@ -530,6 +532,19 @@ pub(crate) fn html(input: &ReportInput) -> String {
          <a href=\"#provenance\">Provenance</a></nav>",
     );
 
+    if !result.incidences.is_empty() {
+        let verdict = result.verdict();
+        let _ = writeln!(
+            out,
+            "<section id=\"verdict\" class=\"verdict\"><strong>Verdict: {}</strong><ul>",
+            esc(&verdict.headline())
+        );
+        for line in verdict.lines() {
+            let _ = writeln!(out, "<li>{}</li>", esc(&line));
+        }
+        out.push_str("</ul></section>\n");
+    }
+
     // One entry per kind (with one incidence the all-incidence fit is that
     // fit: its warnings once, not twice).
     let fit_warnings = brtf_fit::warning_lines(result);
@@ -551,6 +566,12 @@ pub(crate) fn html(input: &ReportInput) -> String {
     }
 
     out.push_str("<section id=\"theta\"><h2>Over θ_in</h2>\n");
+    if result.incidences.len() < 2 {
+        out.push_str(
+            "<p id=\"theta-note\" class=\"muted\">One incidence fitted: the charts over θ_in \
+             need two or more.</p>\n",
+        );
+    }
     for (stem, size, caption) in &input.overview {
         figure(&mut out, stem, *size, caption);
     }
@@ -635,17 +656,10 @@ fn adequacy_line(out: &mut String, a: &brtf_fit::Adequacy) {
         }
     };
     let mut parts = Vec::new();
-    let (label, data, model) = match a.rho_data {
-        Some(d) => ("ρ_dh", Some(d), a.rho_model),
-        None => ("τ_dh", a.tau_data, a.tau_model),
-    };
-    if let (Some(d), Some(ratio)) = (data, a.energy_ratio()) {
+    if let (Some(figure), Some(ratio)) = (a.energy(), a.energy_ratio()) {
         let tolerance = brtf_fit::ENERGY_TOLERANCE;
         let bad = !(1.0 / (1.0 + tolerance)..=1.0 + tolerance).contains(&ratio);
-        parts.push(mark(
-            bad,
-            format!("{label} data {d:.4}, model {model:.4} (ratio {ratio:.3})"),
-        ));
+        parts.push(mark(bad, format!("{figure} (ratio {ratio:.3})")));
     }
     if let Some(p) = a.peak_offset_deg {
         parts.push(mark(

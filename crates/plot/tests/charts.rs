@@ -1,7 +1,8 @@
 //! The chart files: every one exists, PNGs decode at the SVG's size, SVGs
 //! carry their axis titles and one series per incidence, text is drawn.
 
-use crate::common::{TAGS, decode_png, drawn, svg_size};
+use crate::common::{TAGS, decode_png, drawn, repo, svg_size};
+use brtf_plot::PlotOptions;
 
 /// Stems of every chart of the data set and their sizes in pixels.
 fn expected() -> Vec<(String, (u32, u32))> {
@@ -148,4 +149,120 @@ fn overview_svgs_have_one_series_per_incidence() {
         "rms.svg has {circles} markers for {} incidences",
         TAGS.len()
     );
+}
+
+/// `(x, y, width, height)` of every `<rect>` in `svg` filled `fill`.
+fn rects(svg: &str, fill: &str) -> Vec<(f64, f64, f64, f64)> {
+    svg.split("<rect")
+        .skip(1)
+        .map(|r| &r[..r.find("/>").unwrap()])
+        .filter(|r| r.contains(&format!("fill=\"{fill}\"")))
+        .map(|r| {
+            let attr = |name: &str| -> f64 {
+                let key = format!(" {name}=\"");
+                let at = r.find(&key).unwrap() + key.len();
+                r[at..at + r[at..].find('"').unwrap()].parse().unwrap()
+            };
+            (attr("x"), attr("y"), attr("width"), attr("height"))
+        })
+        .collect()
+}
+
+/// `(x, y)` of the `<text>` element whose text is `text`.
+fn text_at(svg: &str, text: &str) -> (f64, f64) {
+    let open = svg
+        .split("<text")
+        .skip(1)
+        .map(|t| t.split_once('>').unwrap())
+        .find(|(_, rest)| rest.split("</text>").next().unwrap().trim() == text)
+        .unwrap_or_else(|| panic!("no `{text}`"))
+        .0;
+    let attr = |name: &str| -> f64 {
+        let key = format!(" {name}=\"");
+        let at = open.find(&key).unwrap() + key.len();
+        open[at..at + open[at..].find('"').unwrap()]
+            .parse()
+            .unwrap()
+    };
+    (attr("x"), attr("y"))
+}
+
+#[test]
+fn the_cut_legend_leaves_the_light_marker_visible() {
+    for tag in TAGS {
+        let cut = svg(&format!("cut-{tag}"));
+        // The legend: the one white, slightly see-through rectangle.
+        let legend = rects(&cut, "#FFFFFF");
+        let legend: Vec<_> = legend.iter().filter(|r| r.2 < 900.0).collect();
+        assert_eq!(legend.len(), 1, "cut-{tag}: {legend:?}");
+        let (x, _, w, _) = *legend[0];
+        // The light's label starts 1° right of its dashed line.
+        let (light, _) = text_at(&cut, "light");
+        assert!(
+            light + 30.0 < x || light - 15.0 > x + w,
+            "cut-{tag}: the light at {light} px under the legend over {x}..{}",
+            x + w
+        );
+    }
+}
+
+#[test]
+fn a_long_sample_name_is_shortened_so_that_no_title_runs_off_its_chart() {
+    let long = "Golden_glossy_paper_measured_on_the_pgII_goniophotometer_at_EPFL_sample_0042_front";
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::copy(
+        repo().join("fits/alu-ggx/fit.json"),
+        dir.path().join("fit.json"),
+    )
+    .unwrap();
+    let mut result = brtf_plot::read_fit(dir.path()).unwrap();
+    result.name = long.into();
+    // Two incidences: the charts over θ_in are drawn too.
+    result.incidences = vec![result.incidences[1].clone(), result.incidences[4].clone()];
+    let options = PlotOptions {
+        search_dirs: vec![repo()],
+        ..PlotOptions::default()
+    };
+    let written = brtf_plot::write_plots(dir.path(), &result, &options).unwrap();
+    let pngs: Vec<_> = written
+        .files
+        .iter()
+        .filter(|f| f.extension().is_some_and(|e| e == "png"))
+        .collect();
+    assert_eq!(pngs.len(), 2 * 2 + 4, "{pngs:?}");
+    for png in pngs {
+        // No glyph in the outermost columns of the title's rows.
+        let (w, _, pixels, channels) = decode_png(png);
+        let dark = |x: u32, y: u32| {
+            let at = (y * w + x) as usize * channels;
+            pixels[at..at + 3].iter().all(|&c| c < 160)
+        };
+        for y in 0..30 {
+            for x in (0..6).chain(w - 6..w) {
+                assert!(!dark(x, y), "{}: text at ({x}, {y})", png.display());
+            }
+        }
+        // Where the whole name does not fit, its start and end are kept
+        // and its middle left out.
+        let svg = std::fs::read_to_string(png.with_extension("svg")).unwrap();
+        let title = svg
+            .split("<text")
+            .filter_map(|t| t.split_once('>'))
+            .map(|(_, rest)| rest.split("</text>").next().unwrap().trim())
+            .find(|t| t.starts_with("Golden"))
+            .unwrap_or_else(|| panic!("{}: no title", png.display()));
+        let stem = png.file_stem().unwrap().to_string_lossy();
+        if title.contains(long) {
+            assert!(!title.contains('…'), "{stem}: {title}");
+            // The widest chart: there the title fits whole.
+            assert_eq!(stem, "params", "{title}");
+        } else {
+            assert!(
+                title.contains("Golden_glossy")
+                    && title.contains("…")
+                    && title.contains("_front (metal)"),
+                "{stem}: {title}"
+            );
+        }
+    }
 }

@@ -235,3 +235,71 @@ fn the_fits_own_data_draw_the_same_plots_as_the_files() {
         }
     }
 }
+
+/// The charts of a whole fit: over θ_in, and every cut in one.
+const OVERVIEW: [&str; 4] = ["params", "rho", "rms", "cuts"];
+
+#[test]
+fn one_incidence_draws_no_chart_over_theta_and_the_report_says_why() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::copy(
+        repo().join("fits/alu-ggx/fit.json"),
+        dir.path().join("fit.json"),
+    )
+    .unwrap();
+    let mut result = brtf_plot::read_fit(dir.path()).unwrap();
+    let options = PlotOptions {
+        search_dirs: vec![repo()],
+        ..PlotOptions::default()
+    };
+    let plots = dir.path().join("plots");
+    let report = dir.path().join("report.html");
+    let note = "One incidence fitted: the charts over θ_in need two or more.";
+    // Two incidences: every chart over θ_in, no note.
+    result
+        .incidences
+        .retain(|r| [15.0, 60.0].contains(&r.theta_in));
+    let written = brtf_plot::write_plots(dir.path(), &result, &options).unwrap();
+    assert_eq!(written.files.len(), 2 * 2 * 2 + 2 * 4 + 1);
+    let html = std::fs::read_to_string(&report).unwrap();
+    for stem in OVERVIEW {
+        assert!(plots.join(format!("{stem}.png")).is_file(), "{stem}");
+        assert!(
+            html.contains(&format!("src=\"plots/{stem}.svg\"")),
+            "{stem}"
+        );
+    }
+    assert!(!html.contains("theta-note") && !html.contains(note));
+
+    // One: its map and cut only (the earlier run's charts over θ_in go),
+    // and one line in their place.
+    result.incidences.truncate(1);
+    let written = brtf_plot::write_plots(dir.path(), &result, &options).unwrap();
+    assert!(written.warnings.is_empty(), "{:?}", written.warnings);
+    let mut names: Vec<String> = std::fs::read_dir(&plots)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        ["cut-t15.png", "cut-t15.svg", "map-t15.png", "map-t15.svg"]
+    );
+    assert_eq!(written.files.len(), 5, "{:?}", written.files);
+    let html = std::fs::read_to_string(&report).unwrap();
+    let theta = &html[html.find("<section id=\"theta\">").expect("the section")..];
+    let theta = &theta[..theta.find("</section>").unwrap()];
+    assert!(theta.contains(note), "{theta}");
+    assert!(!theta.contains("<figure"), "{theta}");
+    for stem in OVERVIEW {
+        assert!(!html.contains(&format!("plots/{stem}.")), "{stem}");
+    }
+    let images: Vec<String> = links(&html)
+        .into_iter()
+        .filter(|l| l.starts_with("plots/"))
+        .collect();
+    assert_eq!(images.len(), 2 * 2 * 2, "{images:?}");
+    for l in &images {
+        assert!(dir.path().join(percent_decode(l)).is_file(), "{l}");
+    }
+}

@@ -292,6 +292,7 @@ impl Fit {
             at,
             theta_dependent: !static_only,
             preview,
+            colour: None,
         };
         let written = py.detach(|| -> Result<Vec<PathBuf>, WorkflowError> {
             let mut files = match klems_options {

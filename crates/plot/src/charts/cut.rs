@@ -11,8 +11,8 @@
 //! that 3° covers. The model is evaluated exactly in the plane.
 
 use super::{
-    CartesianChart, Frame, SMALL, fmt, incidence_label, legend_circle, legend_line, legend_swatch,
-    log_range, mesh, series_legend, titled,
+    CartesianChart, Frame, SMALL, fmt, incidence_label, legend_circle, legend_line, legend_size,
+    legend_swatch, log_range, mesh, series_legend, titled,
 };
 use crate::colour::{self, DATA, GUIDE, MASKED, MODEL, SHADE};
 use crate::figure::{Area, Canvas, Chart, FONT, OrMsg};
@@ -224,6 +224,71 @@ impl<'a> CutData<'a> {
     }
 }
 
+/// A corner of the plot, for a legend.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Corner {
+    UpperLeft,
+    UpperRight,
+    LowerRight,
+    LowerLeft,
+}
+
+impl Corner {
+    /// In order of preference, when several are as good.
+    const ALL: [Corner; 4] = [
+        Corner::UpperLeft,
+        Corner::UpperRight,
+        Corner::LowerRight,
+        Corner::LowerLeft,
+    ];
+}
+
+/// Gap in pixels between a legend in a corner and the plot's edges.
+const LEGEND_GAP: i32 = 5;
+
+/// The rectangle `[x0, y0, x1, y1]` of a legend `legend` pixels large in
+/// `corner` of a plot `plot` pixels large, relative to the plot's upper
+/// left corner.
+pub(crate) fn legend_rect(corner: Corner, plot: (i32, i32), legend: (i32, i32)) -> [i32; 4] {
+    let x0 = match corner {
+        Corner::UpperLeft | Corner::LowerLeft => LEGEND_GAP,
+        Corner::UpperRight | Corner::LowerRight => plot.0 - legend.0 - LEGEND_GAP,
+    };
+    let y0 = match corner {
+        Corner::UpperLeft | Corner::UpperRight => LEGEND_GAP,
+        Corner::LowerLeft | Corner::LowerRight => plot.1 - legend.1 - LEGEND_GAP,
+    };
+    [x0, y0, x0 + legend.0, y0 + legend.1]
+}
+
+/// The corner of a plot `plot` pixels large for a legend `legend` pixels
+/// large: one clear of the light's marker, a line down the whole plot
+/// with its label, between the columns `light` (first, last); of those,
+/// the one over the fewest of `points` (the data and the model, in
+/// pixels). The light is what a reader looks for first on a cut, so it
+/// is never hidden while a corner clear of it exists.
+pub(crate) fn legend_corner(
+    plot: (i32, i32),
+    legend: (i32, i32),
+    light: (i32, i32),
+    points: &[(i32, i32)],
+) -> Corner {
+    let cost = |corner: Corner| {
+        let [x0, y0, x1, y1] = legend_rect(corner, plot, legend);
+        let on_light = light.0 <= x1 && light.1 >= x0;
+        let covered = points
+            .iter()
+            .filter(|(x, y)| (x0..=x1).contains(x) && (y0..=y1).contains(y))
+            .count();
+        (on_light, covered)
+    };
+    // `min_by_key` keeps the first of equals: the preferred corner.
+    Corner::ALL
+        .into_iter()
+        .min_by_key(|c| cost(*c))
+        .unwrap_or(Corner::UpperLeft)
+}
+
 /// The in-plane cut of one incidence.
 pub(crate) struct CutChart<'a> {
     /// The incidence.
@@ -253,8 +318,11 @@ impl Chart for CutChart<'_> {
         let area = titled(root, &self.title)?;
         let mut chart = cut_axes(&area, cut.range, (lo, hi), &inc.unit.axis())?;
 
+        // The legend's lines, in order, to place it.
+        let mut labels: Vec<String> = Vec::new();
         let masked = cut.masked_ranges(inc);
         if !masked.is_empty() {
+            labels.push("masked range (not fitted)".into());
             chart
                 .draw_series(
                     masked
@@ -262,7 +330,7 @@ impl Chart for CutChart<'_> {
                         .map(|&(a, b)| Rectangle::new([(a, lo), (b, hi)], SHADE.filled())),
                 )
                 .msg()?
-                .label("masked range (not fitted)")
+                .label(&labels[0])
                 .legend(legend_swatch(SHADE.filled()));
         }
         let mut marks = vec![(inc.theta_in, "mirror"), (-inc.theta_in, "light")];
@@ -299,6 +367,7 @@ impl Chart for CutChart<'_> {
             .map(|(x, s)| (*x, s.data))
             .collect();
         if !masked_points.is_empty() {
+            labels.push("data, not fitted".into());
             chart
                 .draw_series(
                     masked_points
@@ -306,7 +375,7 @@ impl Chart for CutChart<'_> {
                         .map(|&p| Circle::new(p, 3, MASKED.stroke_width(1))),
                 )
                 .msg()?
-                .label("data, not fitted")
+                .label(&labels[labels.len() - 1])
                 .legend(legend_circle(3, MASKED.stroke_width(1)));
         }
         let mut label = format!(
@@ -324,8 +393,9 @@ impl Chart for CutChart<'_> {
                     .map(|(x, s)| Circle::new((*x, s.data), 2, DATA.filled())),
             )
             .msg()?
-            .label(label)
+            .label(&label)
             .legend(legend_circle(3, DATA.filled()));
+        labels.push(label);
         let model_label = if inc.scale != 1.0 {
             format!("model: {} × f (fitted free scale)", fmt(inc.scale))
         } else {
@@ -337,9 +407,37 @@ impl Chart for CutChart<'_> {
                 MODEL.stroke_width(2),
             ))
             .msg()?
-            .label(model_label)
+            .label(&model_label)
             .legend(legend_line(MODEL.stroke_width(2)));
-        series_legend(&mut chart).draw().msg()
+        labels.push(model_label);
+
+        // Pixels relative to the plot, where the legend is placed.
+        let (xs, ys) = chart.plotting_area().get_pixel_range();
+        let px = |x: f64, y: f64| {
+            let (a, b) = chart.backend_coord(&(x, y));
+            (a - xs.start, b - ys.start)
+        };
+        let line = px(-inc.theta_in, hi).0;
+        let label_at = px(-inc.theta_in + 1.0, hi).0;
+        let (label_width, _) = root
+            .estimate_text_size("light", &(FONT, SMALL).into_font().into())
+            .msg()?;
+        let points: Vec<(i32, i32)> = cut
+            .points
+            .iter()
+            .filter(|(_, s)| positive(s.data))
+            .map(|(x, s)| px(*x, s.data))
+            .chain(cut.curve.iter().map(|&(x, m)| px(x, m.max(lo))))
+            .collect();
+        let plot = (xs.end - xs.start, ys.end - ys.start);
+        let legend = legend_size(&labels);
+        let light = (line - 2, label_at + label_width as i32 + 2);
+        let corner = legend_corner(plot, legend, light, &points);
+        let [x0, y0, _, _] = legend_rect(corner, plot, legend);
+        series_legend(&mut chart)
+            .position(SeriesLabelPosition::Coordinate(x0, y0))
+            .draw()
+            .msg()
     }
 }
 
@@ -400,5 +498,73 @@ impl Chart for CutsChart<'_> {
                 .legend(legend_line(c.stroke_width(2)));
         }
         series_legend(&mut chart).draw().msg()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A cut's plot and legend, in pixels.
+    const PLOT: (i32, i32) = (880, 520);
+    const LEGEND: (i32, i32) = (390, 90);
+
+    /// The light's marker at `x` pixels: the line and its label.
+    fn light(x: i32) -> (i32, i32) {
+        (x - 2, x + 40)
+    }
+
+    fn clear_of(corner: Corner, light: (i32, i32)) -> bool {
+        let [x0, _, x1, _] = legend_rect(corner, PLOT, LEGEND);
+        light.1 < x0 || light.0 > x1
+    }
+
+    #[test]
+    fn the_legend_takes_the_side_away_from_the_light() {
+        // θ_in = 30° on ±90°: the light at a third of the width, left.
+        let left = light(290);
+        let corner = legend_corner(PLOT, LEGEND, left, &[]);
+        assert!(clear_of(corner, left), "{corner:?}");
+        assert!(matches!(corner, Corner::UpperRight | Corner::LowerRight));
+        // The light on the right (the mirror image).
+        let right = light(PLOT.0 - 290);
+        let corner = legend_corner(PLOT, LEGEND, right, &[]);
+        assert!(clear_of(corner, right), "{corner:?}");
+        assert_eq!(corner, Corner::UpperLeft);
+        // A legend narrower than half the plot leaves the light visible
+        // wherever it is.
+        for x in (0..PLOT.0).step_by(10) {
+            let corner = legend_corner(PLOT, LEGEND, light(x), &[]);
+            assert!(clear_of(corner, light(x)), "light at {x}: {corner:?}");
+        }
+    }
+
+    #[test]
+    fn of_the_corners_clear_of_the_light_the_emptiest_is_taken() {
+        // The mirror peak in the upper right, the light on the left: the
+        // legend goes to the lower right.
+        let peak: Vec<(i32, i32)> = (0..60).map(|k| (600 + k, 10 + k)).collect();
+        let corner = legend_corner(PLOT, LEGEND, light(290), &peak);
+        assert_eq!(corner, Corner::LowerRight);
+        // Points alone never put the legend on the light.
+        let everywhere: Vec<(i32, i32)> = (0..PLOT.0)
+            .step_by(4)
+            .flat_map(|x| [(x, 20), (x, PLOT.1 - 20)])
+            .filter(|&(x, _)| x > 440)
+            .collect();
+        let corner = legend_corner(PLOT, LEGEND, light(290), &everywhere);
+        assert!(clear_of(corner, light(290)), "{corner:?}");
+    }
+
+    #[test]
+    fn the_legend_rectangle_sits_in_its_corner() {
+        assert_eq!(
+            legend_rect(Corner::UpperLeft, PLOT, LEGEND),
+            [5, 5, 395, 95]
+        );
+        assert_eq!(
+            legend_rect(Corner::LowerRight, PLOT, LEGEND),
+            [485, 425, 875, 515]
+        );
     }
 }

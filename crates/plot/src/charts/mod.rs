@@ -120,8 +120,37 @@ where
         .position(SeriesLabelPosition::UpperLeft)
         .background_style(WHITE.mix(0.9))
         .border_style(BLACK)
-        .label_font((FONT, SMALL));
+        .label_font((FONT, SMALL))
+        .legend_area_size(LEGEND_SYMBOLS)
+        .margin(LEGEND_MARGIN);
     legend
+}
+
+/// Width in pixels of the symbol column of a legend.
+const LEGEND_SYMBOLS: i32 = 30;
+/// Margin in pixels inside a legend's frame.
+const LEGEND_MARGIN: i32 = 10;
+
+/// Width and height in pixels of the legend [`series_legend`] draws for
+/// `labels`, laid out as plotters lays it out: a line every 1.25 font
+/// sizes, the symbol column, the margins.
+pub(crate) fn legend_size(labels: &[String]) -> (i32, i32) {
+    crate::figure::register_fonts();
+    let font = (FONT, SMALL).into_font();
+    let (mut w, mut h) = (0, 0);
+    for (k, label) in labels.iter().enumerate() {
+        let (lw, lh) = font.box_size(label).unwrap_or_else(|_| {
+            let chars = label.chars().count() as f64;
+            ((chars * 0.62 * SMALL) as u32, SMALL as u32)
+        });
+        let top = (k as f64 * SMALL * 1.25).round() as i32;
+        w = w.max(lw as i32);
+        h = h.max(top + lh as i32);
+    }
+    (
+        w + LEGEND_SYMBOLS + 2 * LEGEND_MARGIN,
+        h + 2 * LEGEND_MARGIN,
+    )
 }
 
 /// A legend entry's symbol for a line series: a short line in `style`.
@@ -171,9 +200,100 @@ pub(crate) fn left(size: f64) -> TextStyle<'static> {
     text(size, &BLACK, HPos::Left, VPos::Center)
 }
 
+/// Room in pixels left free at either end of a title: SVG viewers draw it
+/// in their own sans-serif, which may run a little wider than DejaVu Sans.
+const TITLE_MARGIN: u32 = 20;
+/// What stands for the characters left out of a title.
+const ELLIPSIS: char = '…';
+
+/// Width in pixels of `text` in the title font (the embedded DejaVu Sans),
+/// or an estimate of 0.62 of the font size per character if the font is
+/// not at hand.
+pub(crate) fn title_width(text: &str) -> u32 {
+    crate::figure::register_fonts();
+    (FONT, TITLE)
+        .into_font()
+        .box_size(text)
+        .map(|(w, _)| w)
+        .unwrap_or_else(|_| (text.chars().count() as f64 * 0.62 * TITLE).ceil() as u32)
+}
+
+/// The widest a title may be on a chart `chart_width` pixels wide.
+pub(crate) fn title_room(chart_width: u32) -> u32 {
+    chart_width.saturating_sub(2 * TITLE_MARGIN)
+}
+
+/// The title `name` then `rest` for a chart `chart_width` pixels wide.
+/// When too wide, the name (a sample name may be any length) loses
+/// characters from its middle, where an ellipsis stands for them, so
+/// that its start and its end (often a sample number) stay, and so does
+/// `rest`, which says what the chart shows. If even that is too wide, the
+/// end of the whole title goes.
+pub(crate) fn fit_title(name: &str, rest: &str, chart_width: u32) -> String {
+    let room = title_room(chart_width);
+    let whole = format!("{name}{rest}");
+    if title_width(&whole) <= room {
+        return whole;
+    }
+    let chars: Vec<char> = name.chars().collect();
+    // The name cut to `keep` characters: the first half and the last.
+    let cut = |keep: usize| -> String {
+        let head = keep.div_ceil(2);
+        let tail = keep - head;
+        let mut s: String = chars[..head].iter().collect();
+        s.push(ELLIPSIS);
+        s.extend(&chars[chars.len() - tail..]);
+        s.push_str(rest);
+        s
+    };
+    if title_width(&cut(0)) > room {
+        return fit_end(&whole, room);
+    }
+    // The most characters that fit: the width grows with `keep`, so a
+    // bisection finds it.
+    let (mut fits, mut too_wide) = (0, chars.len());
+    while too_wide - fits > 1 {
+        let mid = (fits + too_wide) / 2;
+        if title_width(&cut(mid)) <= room {
+            fits = mid;
+        } else {
+            too_wide = mid;
+        }
+    }
+    cut(fits)
+}
+
+/// `text`, or as much of its start as fits in `room` pixels with an
+/// ellipsis after it.
+pub(crate) fn fit_end(text: &str, room: u32) -> String {
+    if title_width(text) <= room {
+        return text.to_string();
+    }
+    let chars: Vec<char> = text.chars().collect();
+    let cut = |keep: usize| -> String {
+        let mut s: String = chars[..keep].iter().collect();
+        s.push(ELLIPSIS);
+        s
+    };
+    let (mut fits, mut too_wide) = (0, chars.len());
+    while too_wide - fits > 1 {
+        let mid = (fits + too_wide) / 2;
+        if title_width(&cut(mid)) <= room {
+            fits = mid;
+        } else {
+            too_wide = mid;
+        }
+    }
+    cut(fits)
+}
+
 /// Draws the chart's title centred at the top and returns the area below.
+/// A title too wide for the chart (the callers fit theirs already, see
+/// [`fit_title`]) loses its end rather than run off the image.
 pub(crate) fn titled<DB: DrawingBackend>(root: &Area<DB>, title: &str) -> Result<Area<DB>, String> {
-    root.titled(title, (FONT, TITLE).into_font().color(&BLACK))
+    let (w, _) = root.dim_in_pixel();
+    let title = fit_end(title, title_room(w));
+    root.titled(&title, (FONT, TITLE).into_font().color(&BLACK))
         .msg()
 }
 
@@ -308,6 +428,47 @@ mod tests {
         assert_eq!(f(&0.1531), "0.1531");
         let f = lin_fmt(0.0, 60.0);
         assert_eq!(f(&20.0), "20");
+    }
+
+    /// An 82-character sample name.
+    const LONG: &str =
+        "Golden_glossy_paper_measured_on_the_pgII_goniophotometer_at_EPFL_sample_0042_front";
+
+    #[test]
+    fn a_short_name_keeps_its_title() {
+        let rest = " (metal), θ_in = 30°: cut through the plane of incidence";
+        let title = fit_title("alu-ggx", rest, 1000);
+        assert_eq!(title, format!("alu-ggx{rest}"));
+        assert!(title_width(&title) <= title_room(1000));
+    }
+
+    #[test]
+    fn a_long_name_is_shortened_in_the_middle_to_fit() {
+        let rest = " (metal), θ_in = 30°: model ÷ data over the hemisphere";
+        for width in [990, 1000, 900, 1300, 700] {
+            let whole = format!("{LONG}{rest}");
+            assert!(title_width(&whole) > title_room(width), "{width}");
+            let title = fit_title(LONG, rest, width);
+            let w = title_width(&title);
+            assert!(w <= title_room(width), "{title}: {w} px on {width}");
+            // Nearly all the room is used: not shortened more than needed.
+            assert!(w + 3 * TITLE as u32 > title_room(width), "{title}: {w} px");
+            assert!(title.ends_with(rest), "{title}");
+            let head = if width >= 900 {
+                "Golden_glossy"
+            } else {
+                "Gold"
+            };
+            assert!(title.starts_with(head), "{title}");
+            assert!(
+                title.contains("…") && title.contains("front (metal)"),
+                "{title}"
+            );
+        }
+        // No room even for the rest: its end goes too.
+        let title = fit_title(LONG, rest, 300);
+        assert!(title_width(&title) <= title_room(300), "{title}");
+        assert!(title.starts_with("Gold") && title.ends_with('…'), "{title}");
     }
 
     #[test]

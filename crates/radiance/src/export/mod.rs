@@ -39,6 +39,9 @@ pub struct ExportOptions {
     pub theta_dependent: bool,
     /// Write the preview scene.
     pub preview: bool,
+    /// A colour measured elsewhere (`--colour R,G,B`): each material takes
+    /// its chromaticity at its own fitted luminance.
+    pub colour: Option<[f64; 3]>,
 }
 
 impl ExportOptions {
@@ -63,6 +66,7 @@ impl Default for ExportOptions {
             at: None,
             theta_dependent: true,
             preview: true,
+            colour: None,
         }
     }
 }
@@ -84,6 +88,9 @@ pub enum ExportError {
         /// What is wrong.
         source: ModelError,
     },
+    /// `--colour` is not a colour.
+    #[error(transparent)]
+    Colour(#[from] brtf_fit::ColourError),
     /// The θ_in table's shape is not one brtf fits.
     #[error("the θ_in table: {0}")]
     Table(String),
@@ -161,6 +168,14 @@ pub fn preview_file_name(name: &str) -> String {
 
 /// Builds every export of `result` in memory.
 pub fn exports(result: &FitResult, options: &ExportOptions) -> Result<Export, ExportError> {
+    let coloured;
+    let result = match options.colour {
+        Some(rgb) => {
+            coloured = result.with_colour(rgb)?;
+            &coloured
+        }
+        None => result,
+    };
     let name = material_name(result, options)?;
     let chosen = static_material::choose(result, options.at)?;
     let mut files = Vec::new();
@@ -174,7 +189,7 @@ pub fn exports(result: &FitResult, options: &ExportOptions) -> Result<Export, Ex
             );
             None
         }
-        (Some(table), true) => Some(theta::build(result, table, &name)?),
+        (Some(table), true) => Some(theta::build(result, table, &name, options.colour)?),
         (None, true) => {
             notes.push(format!(
                 "no θ_in-dependent material: the fit has {} incidence(s), interpolation needs two",
@@ -184,7 +199,7 @@ pub fn exports(result: &FitResult, options: &ExportOptions) -> Result<Export, Ex
         }
         (_, false) => None,
     };
-    let stat = static_material::text(result, &chosen, &name, theta.is_some());
+    let stat = static_material::text(result, &chosen, &name, theta.is_some(), options.colour);
     notes.extend(stat.notes);
     files.push(ExportFile {
         file_name: static_file_name(&name),

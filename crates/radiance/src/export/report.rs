@@ -68,6 +68,41 @@ pub(crate) fn provenance(result: &FitResult) -> Vec<String> {
     lines
 }
 
+/// Where the material's colour comes from, when the measurement did not
+/// give it: `--colour`, or nowhere (grey).
+pub(crate) fn colour_line(result: &FitResult, colour: Option<[f64; 3]>) -> Option<String> {
+    match (colour, result.colour_measured()) {
+        (Some([r, g, b]), measured) => Some(format!(
+            "Colour: given with --colour {},{},{} (its chromaticity at the fitted luminance){}.",
+            sig(r, 4),
+            sig(g, 4),
+            sig(b, 4),
+            if measured == Some(true) {
+                "; it replaces the measured colour"
+            } else {
+                "; the scans measured luminance only"
+            }
+        )),
+        (None, Some(false)) => Some(
+            "Colour: not measured (one-channel CIE-Y data): the material is grey, R = G = B; \
+             give --colour R,G,B to export one."
+                .into(),
+        ),
+        _ => None,
+    }
+}
+
+/// The fit's verdict ([`FitResult::verdict`]): a headline and its parts.
+pub(crate) fn verdict(result: &FitResult) -> Vec<String> {
+    if result.incidences.is_empty() {
+        return Vec::new();
+    }
+    let verdict = result.verdict();
+    let mut lines = vec![format!("Verdict: {}.", ascii(&verdict.headline()))];
+    lines.extend(verdict.lines().iter().map(|l| format!("  {}", ascii(l))));
+    lines
+}
+
 /// One line: how well a report fits its data.
 pub(crate) fn quality(report: &FitReport) -> String {
     format!(
@@ -343,6 +378,8 @@ pub(crate) fn ascii(s: &str) -> String {
         .map(|c| match c {
             'θ' => "theta".to_string(),
             'φ' => "phi".to_string(),
+            'ρ' => "rho".to_string(),
+            'τ' => "tau".to_string(),
             '°' => " deg".to_string(),
             '≈' => "~".to_string(),
             '÷' => "/".to_string(),

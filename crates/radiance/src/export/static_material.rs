@@ -96,7 +96,13 @@ pub(crate) fn choose(result: &FitResult, at: Option<f64>) -> Result<Chosen<'_>, 
 }
 
 /// The file text.
-pub(crate) fn text(result: &FitResult, chosen: &Chosen, name: &str, with_theta: bool) -> Text {
+pub(crate) fn text(
+    result: &FitResult,
+    chosen: &Chosen,
+    name: &str,
+    with_theta: bool,
+    colour: Option<[f64; 3]>,
+) -> Text {
     let material = &chosen.material;
     let kind = material.kind();
     let shape = result.config.shape();
@@ -125,12 +131,8 @@ pub(crate) fn text(result: &FitResult, chosen: &Chosen, name: &str, with_theta: 
         String::new(),
     ]);
     h.extend(report::provenance(result));
-    if result.colour_measured() == Some(false) {
-        h.push(
-            "Colour: not measured (one-channel CIE-Y data): the material is grey, R = G = B."
-                .into(),
-        );
-    }
+    h.extend(report::colour_line(result, colour));
+    h.extend(report::verdict(result));
     h.push(String::new());
     let (lo, hi) = result
         .table

@@ -47,6 +47,7 @@ pub(crate) fn build(
     result: &FitResult,
     table: &ParamTable,
     name: &str,
+    colour: Option<[f64; 3]>,
 ) -> Result<Theta, ExportError> {
     let kind = table.kind;
     let shape = table.shape();
@@ -285,6 +286,9 @@ Reciprocity: the parameters follow the light's direction, so f(l, v) and f(v, l)
 differ. Light sources play the role of the gonio-photometer's lamp; tools that
 treat other surfaces as sources (mkillum) give theta_in from those.",
     ));
+    h.push(String::new());
+    h.extend(report::colour_line(result, colour));
+    h.extend(report::verdict(result));
     if let Some(scale) = report::scale_caveat(result) {
         h.push(String::new());
         h.push(format!("Caveat: {scale}"));
