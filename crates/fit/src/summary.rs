@@ -40,7 +40,8 @@ pub fn summary(result: &FitResult, out: &Path) -> String {
     if result.colour_measured() == Some(false) {
         let _ = writeln!(
             s,
-            "  colour not measured (one-channel CIE-Y data): the material is grey, R = G = B"
+            "  colour not measured (one-channel CIE-Y data): the material is grey, R = G = B; \
+             `brtf export DIR --colour R,G,B` gives it one"
         );
     }
     let names: Vec<&str> = result

@@ -138,7 +138,7 @@ impl FitResult {
     pub fn verdict(&self) -> Verdict {
         let reports = &self.incidences;
         let checked = reports.iter().any(|r| r.adequacy.is_some());
-        let not_checked = "not checked (--no-adequacy)";
+        let not_checked = "not checked: --no-adequacy";
         let energy = if self.config.free_scale {
             Aspect {
                 what: "energy",
@@ -253,15 +253,22 @@ impl Verdict {
     /// judged, misplaced light, θ_in validity.
     pub fn lines(&self) -> Vec<String> {
         let mut out = Vec::new();
-        for (label, trust) in [
-            ("trust", Trust::Yes),
-            ("do not trust", Trust::No),
-            ("not judged", Trust::Unknown),
-        ] {
+        for (label, trust) in [("trust", Trust::Yes), ("do not trust", Trust::No)] {
             let items = self.list(trust);
             if !items.is_empty() {
                 out.push(format!("{label}: {}", items.join("; ")));
             }
+        }
+        // Aspects nothing could judge, grouped by the reason.
+        let mut unknown: Vec<(&str, Vec<&str>)> = Vec::new();
+        for a in self.aspects.iter().filter(|a| a.trust == Trust::Unknown) {
+            match unknown.iter_mut().find(|(why, _)| *why == a.why) {
+                Some((_, names)) => names.push(a.what),
+                None => unknown.push((&a.why, vec![a.what])),
+            }
+        }
+        for (why, names) in unknown {
+            out.push(format!("not judged: {} ({why})", names.join(", ")));
         }
         if let Some((lo, hi)) = self.e1 {
             out.push(if hi - lo < 5e-4 {

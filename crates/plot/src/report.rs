@@ -464,7 +464,8 @@ fn provenance_section(out: &mut String, dir: &Path, result: &FitResult) {
         c.options.fresnel_k,
         c.options.source_omega,
         match (result.colour_measured(), c.gray) {
-            (Some(false), _) => "colour not measured (one-channel CIE-Y data): grey, R = G = B",
+            (Some(false), _) =>
+                "colour not measured (one-channel CIE-Y data): grey, R = G = B (brtf export --colour R,G,B gives one)",
             (_, true) => "grey (R = G = B, --gray)",
             _ => "red, green and blue fitted",
         },
