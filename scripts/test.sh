@@ -16,6 +16,12 @@ if ! .venv/bin/python -c "import numpy, scipy" 2>/dev/null; then
     echo "== installing numpy and scipy (the scipy peer) into .venv"
     .venv/bin/pip install --quiet --disable-pip-version-check numpy scipy
 fi
+# pyWinCalc, LBNL WINDOW's calculation engine, reads the Klems exports
+# (tests/cli/klems_export.rs).
+if ! .venv/bin/python -c "import pywincalc" 2>/dev/null; then
+    echo "== installing pywincalc 3.3.1 (WINDOW's engine) into .venv"
+    .venv/bin/pip install --quiet --disable-pip-version-check pywincalc==3.3.1
+fi
 pkg=$(.venv/bin/python -c "import os, pyradiance; print(os.path.dirname(pyradiance.__file__))")
 export RADIANCE_BIN="$pkg/bin"
 export RAYPATH=".:$pkg/lib"

@@ -59,9 +59,9 @@ pub(crate) struct KlemsArgs {
     #[arg(long, value_name = "N", requires = "klems",
           default_value_t = brtf_gonio::klems::DEFAULT_SAMPLES)]
     pub klems_samples: usize,
-    /// Add a Solar band: `visible` repeats the Visible values (the header says
-    /// so), or a Radiance file with a material of the solar properties.
-    #[arg(long, value_name = "visible|S.rad", requires = "klems")]
+    /// The Solar band: `visible` (default) repeats Visible, saying so; `none`;
+    /// or a Radiance file with a material of the solar properties.
+    #[arg(long, value_name = "visible|none|S.rad", requires = "klems")]
     pub solar: Option<String>,
     /// Add CIE-X and CIE-Z bands (colour).
     #[arg(long, requires = "klems")]

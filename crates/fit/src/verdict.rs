@@ -120,14 +120,17 @@ fn judge(
         };
     }
     let where_: Vec<&FitReport> = failed.iter().map(|(r, _)| *r).collect();
+    let count = if judged.len() == 1 {
+        "at the one incidence".to_string()
+    } else {
+        format!("at {} of {} incidences", failed.len(), judged.len())
+    };
     Aspect {
         what,
         trust: Trust::No,
         why: format!(
-            "{} at {} of {} incidences, {}",
+            "{} {count}, {}",
             describe(worst(&failed), failed.len() > 1),
-            failed.len(),
-            judged.len(),
             theta_span(&where_)
         ),
     }

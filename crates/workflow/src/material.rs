@@ -27,12 +27,13 @@ pub fn read_material_file(
     Ok(brtf_radiance::select_composite(&primitives, name, &shown)?)
 }
 
-/// The Solar band of `--solar`: none, `visible` (the Visible values again,
-/// said in the file as an assumption), or the material of a Radiance file.
+/// The Solar band of `--solar`: `visible` (the default: the Visible values
+/// again, said in the file as an assumption; WINDOW and pyWinCalc need a
+/// Solar band), `none`, or the material of a Radiance file.
 pub fn solar_band(arg: Option<&str>) -> Result<SolarBand, WorkflowError> {
     Ok(match arg {
-        None => SolarBand::None,
-        Some("visible") => SolarBand::ReuseVisible,
+        None | Some("visible") => SolarBand::ReuseVisible,
+        Some("none") => SolarBand::None,
         Some(file) => SolarBand::Material {
             material: read_material_file(Path::new(file), None)
                 .map_err(|e| WorkflowError::Usage(format!("--solar {file}: {e}")))?

@@ -9,7 +9,8 @@
 //! `DataDefinition` (`Columns`, the basis with its blocks) and one
 //! `WavelengthData` per band and direction. Values are written row by row
 //! (one outgoing patch per line), `values[o * n + i]`, as Radiance reads
-//! `Columns` data.
+//! `Columns` data, each followed by a comma as WINDOW writes them
+//! (pyWinCalc reads space-separated rows as one row: "Non-square matrix").
 
 use std::fmt::Write;
 
@@ -194,6 +195,7 @@ pub fn to_klems_xml(
                     o.push(' ');
                 }
                 value_text(v, &mut o);
+                o.push(',');
             }
             o.push('\n');
         }

@@ -30,10 +30,10 @@ use brtf_model::{Bsdf, Composite, EvalOptions, Material, Rgb};
 /// Where the Solar band comes from.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub enum SolarBand {
-    /// No Solar band (Radiance ignores it anyway).
-    #[default]
+    /// No Solar band (Radiance ignores it; WINDOW and pyWinCalc need one).
     None,
     /// The Visible values again, stated as an assumption in the header.
+    #[default]
     ReuseVisible,
     /// The luminance-weighted BSDF of this static material (the user's
     /// solar properties), from the file named.
@@ -74,7 +74,7 @@ impl KlemsOptions {
         KlemsOptions {
             basis: KlemsBasis::full(),
             sampling: SampleOptions::default(),
-            solar: SolarBand::None,
+            solar: SolarBand::ReuseVisible,
             colour: false,
             name: name.to_string(),
             manufacturer: "brtf".into(),
