@@ -621,7 +621,11 @@ fn klems_of_a_lobe_sum_file() {
     let xml = std::fs::read_to_string(tmp.path().join("two.xml")).unwrap();
     assert!(xml.contains("lobe sum (mixfunc of 2 primitives)"), "{xml}");
     let klems = brtf_gonio::klems::read_str(&xml, "two.xml").unwrap();
-    assert_eq!(klems.matrices.len(), 2, "front and back reflection");
+    assert_eq!(
+        klems.matrices.len(),
+        4,
+        "front and back reflection, Visible and the default Solar"
+    );
     let cal = std::fs::read_to_string(tmp.path().join("two-bsdf2klems.cal")).unwrap();
     assert!(
         cal.contains("side(ix,iy,iz,ox,oy,oz) = 2.99999999999999989e-1*side_1(ix,iy,iz,ox,oy,oz)\n    + 6.99999999999999956e-1*side_2("),

@@ -449,6 +449,7 @@ fn a_lobe_sum_s_matrices_are_its_lobes_weighted() {
     options.basis = KlemsBasis::built_in("LBNL/Klems Quarter").unwrap();
     options.sampling.samples = 16;
     options.colour = true;
+    options.solar = brtf_radiance::export::klems::SolarBand::None;
     let eval = EvalOptions::default();
     let of = |m: &Composite| klems_from_composite(m, &eval, "m.rad", "00", &options).unwrap();
     let whole = of(&sum);
