@@ -456,3 +456,73 @@ fn many_incidences_give_warnings_by_kind() {
             .all(|i| i["warnings"].as_array().is_some_and(|w| !w.is_empty()))
     );
 }
+
+/// A one-sided Klems file (genBSDF writes the front side only, with
+/// `<Name>Name</Name>` when given no name) is fitted on the side it has by
+/// default, and the material is named after the file, not "Name".
+#[test]
+fn a_one_sided_file_fits_its_side_and_is_named_after_the_file() {
+    let dir = temp_dir();
+    let material = dir.path().join("m.rad");
+    std::fs::write(
+        &material,
+        "void trans m\n0\n0\n7 0.6 0.6 0.6 0.06 0.1 0.4 0.5\n",
+    )
+    .unwrap();
+    brtf(
+        &[
+            "export",
+            "--klems",
+            "--material",
+            s(&material),
+            "--out",
+            s(dir.path()),
+        ],
+        "",
+    )
+    .ok();
+    let both = std::fs::read_to_string(dir.path().join("m.xml")).unwrap();
+    // Keep the front side's blocks (light from +z: Transmission/Reflection Back).
+    let mut parts = both.split("\t<WavelengthData>");
+    let mut one = parts.next().unwrap().to_string();
+    for block in parts {
+        if !block.contains("Front</WavelengthDataDirection>") {
+            one += "\t<WavelengthData>";
+            one += block;
+        } else if let Some(tail) = block.split_once("</WavelengthData>\n").map(|(_, t)| t) {
+            one += tail;
+        }
+    }
+    let one = one.replace("<Name>m</Name>", "<Name>Name</Name>");
+    assert!(one.contains("<Name>Name</Name>") && !one.contains("Front</WavelengthDataDirection>"));
+    let file = dir.path().join("cl_Tn0.33.xml");
+    std::fs::write(&file, one).unwrap();
+    let out = dir.path().join("fit");
+    let run = brtf(
+        &[
+            "fit",
+            s(&file),
+            "--model",
+            "trans",
+            "--gray",
+            "--incidences",
+            "theta<=20",
+            "--no-plots",
+            "--no-adequacy",
+            "--out",
+            s(&out),
+        ],
+        "",
+    );
+    let stderr = run.stderr.clone();
+    run.ok();
+    assert!(
+        stderr.contains("note: the Klems file holds the front side only"),
+        "{stderr}"
+    );
+    let fit: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("fit.json")).unwrap()).unwrap();
+    assert_eq!(fit["name"], "cl_Tn0.33");
+    assert!(out.join("cl_Tn0.33.rad").is_file());
+    assert!(!out.join("front").exists() && !out.join("back").exists());
+}

@@ -73,7 +73,12 @@ pub fn default_name(files: &[PathBuf], klems: bool) -> Result<String, WorkflowEr
     let mut sample_names = Vec::new();
     for file in files {
         let name = if klems {
-            brtf_gonio::klems::read_path(file)?.header.name
+            // genBSDF writes `<Name>Name</Name>` when given none.
+            let name = brtf_gonio::klems::read_path(file)?.header.name;
+            name.filter(|n| {
+                let n = n.trim().to_ascii_lowercase();
+                !["", "name", "unnamed", "untitled"].contains(&n.as_str())
+            })
         } else {
             // The header alone: the fit reads and checks the whole file.
             brtf_gonio::read_sample_name_at(file).map_err(|source| {
@@ -96,6 +101,22 @@ pub fn default_name(files: &[PathBuf], klems: bool) -> Result<String, WorkflowEr
         })
         .collect();
     Ok(brtf_radiance::default_fit_name(&sample_names, &stems))
+}
+
+/// The sides of a Klems fit's files that hold data (front first).
+pub(crate) fn klems_sides(
+    files: &[PathBuf],
+) -> Result<Vec<brtf_gonio::klems::Side>, WorkflowError> {
+    let mut sides = Vec::new();
+    for file in files {
+        for side in brtf_gonio::klems::read_path(file)?.sides_present() {
+            if !sides.contains(&side) {
+                sides.push(side);
+            }
+        }
+    }
+    sides.sort_by_key(|s| *s != brtf_gonio::klems::Side::Front);
+    Ok(sides)
 }
 
 /// The measurement files of a sample folder: `.mpc` and `.txt`, sorted.

@@ -123,8 +123,21 @@ pub fn fit_to_folder(
         .clone()
         .unwrap_or_else(|| Path::new("fits").join(job.name()));
     let update = FolderUpdate::fresh(&out)?;
+    let mut notes = Vec::new();
     let sides: Vec<Option<Side>> = if job.klems {
-        sides.sides().into_iter().map(Some).collect()
+        let mut wanted = sides.sides();
+        // Both by default: the sides the file has (genBSDF writes one).
+        if sides == Sides::Both {
+            let present = crate::inputs::klems_sides(&job.files)?;
+            if let [only] = present[..] {
+                wanted = vec![only];
+                notes.push(format!(
+                    "note: the Klems file holds the {only} side only (light from {}): that side is fitted",
+                    if only == Side::Front { "+z" } else { "−z" }
+                ));
+            }
+        }
+        wanted.into_iter().map(Some).collect()
     } else {
         vec![None]
     };
@@ -139,7 +152,7 @@ pub fn fit_to_folder(
         out: out.clone(),
         results: Vec::new(),
         text: String::new(),
-        notes: Vec::new(),
+        notes,
     };
     for side in sides {
         if let Some(side) = side {

@@ -361,6 +361,19 @@ pub struct KlemsBsdf {
 }
 
 impl KlemsBsdf {
+    /// The sides with Visible data (front first): genBSDF and one side's
+    /// export write one side only.
+    pub fn sides_present(&self) -> Vec<Side> {
+        Side::BOTH
+            .into_iter()
+            .filter(|&side| {
+                self.matrices
+                    .iter()
+                    .any(|m| m.band == KlemsBand::Visible && m.direction.incident_side() == side)
+            })
+            .collect()
+    }
+
     /// The matrix of `band` and `direction`, if the file has it.
     pub fn matrix(&self, band: &KlemsBand, direction: KlemsDirection) -> Option<&KlemsMatrix> {
         self.matrices
