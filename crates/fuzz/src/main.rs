@@ -10,7 +10,7 @@ use brtf_fuzz::run::thread_cpu_time;
 use brtf_fuzz::{Config, SeedSources, Seeds, Target, format_report, make_case, run, run_case};
 use clap::Parser;
 
-/// Mutation fuzzing of the .mpc, Mountain, .rad and fit.json parsers.
+/// Mutation fuzzing of the .mpc, Mountain, .rad, fit.json and Klems XML parsers.
 #[derive(Parser, Debug)]
 #[command(version)]
 struct Args {
@@ -63,6 +63,8 @@ enum TargetArg {
     Rad,
     /// `fit.json`.
     FitJson,
+    /// Klems BSDF XML, and brtf's Klems writer.
+    Klems,
 }
 
 impl TargetArg {
@@ -73,6 +75,7 @@ impl TargetArg {
             TargetArg::Detected => Target::DetectedGonio,
             TargetArg::Rad => Target::Rad,
             TargetArg::FitJson => Target::FitJson,
+            TargetArg::Klems => Target::Klems,
         }
     }
 }

@@ -22,16 +22,20 @@ pub enum Target {
     Rad,
     /// `brtf_fit::FitResult::from_json` and what `brtf export` does next.
     FitJson,
+    /// `brtf_gonio::klems::read_bytes`, then `brtf info`, the conversion to
+    /// measurements and brtf's Klems writer and back.
+    Klems,
 }
 
 impl Target {
     /// Every target, in report order.
-    pub const ALL: [Target; 5] = [
+    pub const ALL: [Target; 6] = [
         Target::Mpc,
         Target::Mountain,
         Target::DetectedGonio,
         Target::Rad,
         Target::FitJson,
+        Target::Klems,
     ];
 
     /// A short name for reports.
@@ -42,6 +46,7 @@ impl Target {
             Target::DetectedGonio => "gonio (detected)",
             Target::Rad => "rad",
             Target::FitJson => "fit.json",
+            Target::Klems => "klems xml",
         }
     }
 }
@@ -146,13 +151,34 @@ impl Seeds {
         // patch holding its centre), 41 x 41 per block, so one case costs
         // well under a millisecond; the whole files are too slow for CI.
         let mecho = data.join("lbnl-frads-klems-fabrics/klems_aniso_high.xml");
+        let quarter = klems_quarter(&mecho)?;
+        for target in [Target::DetectedGonio, Target::Klems] {
+            seeds.all.push(Seed {
+                target,
+                name: "klems_quarter.xml".into(),
+                origin: "klems_aniso_high.xml on the Klems Quarter basis".into(),
+                bytes: quarter.clone().into_bytes(),
+                whole_big_file: false,
+            });
+        }
+        // The same data as brtf writes it (comma rows, comments, schema).
         seeds.all.push(Seed {
-            target: Target::DetectedGonio,
-            name: "klems_quarter.xml".into(),
-            origin: "klems_aniso_high.xml on the Klems Quarter basis".into(),
-            bytes: klems_quarter(&mecho)?.into_bytes(),
+            target: Target::Klems,
+            name: "klems_quarter_brtf.xml".into(),
+            origin: "klems_aniso_high.xml on the Quarter basis, written by brtf".into(),
+            bytes: rewritten(&quarter, "klems_quarter.xml")?.into_bytes(),
             whole_big_file: false,
         });
+        // The whole real files, picked rarely.
+        for path in files_with_extension(&data.join("lbnl-frads-klems-fabrics"), "xml")? {
+            seeds.all.push(Seed {
+                target: Target::Klems,
+                name: file_name(&path),
+                origin: format!("{}, whole", file_name(&path)),
+                bytes: read(&path)?,
+                whole_big_file: true,
+            });
+        }
         for path in rad_files(repo) {
             let Ok(bytes) = std::fs::read(&path) else {
                 continue; // vanished since the walk
@@ -174,7 +200,13 @@ impl Seeds {
             bytes: read(&fit_json)?,
             whole_big_file: false,
         });
-        for target in [Target::Mpc, Target::Mountain, Target::Rad, Target::FitJson] {
+        for target in [
+            Target::Mpc,
+            Target::Mountain,
+            Target::Rad,
+            Target::FitJson,
+            Target::Klems,
+        ] {
             if !seeds.all.iter().any(|s| s.target == target) {
                 return Err(format!("no seed file for {}", target.label()));
             }
@@ -322,6 +354,35 @@ fn collect_rad_files(dir: &Path, out: &mut Vec<PathBuf>) {
             out.push(path);
         }
     }
+}
+
+/// A Klems file's text as brtf's writer writes it (its header, basis and
+/// every matrix).
+fn rewritten(text: &str, name: &str) -> Result<String, String> {
+    let bsdf = brtf_gonio::klems::read_str(text, name).map_err(|e| e.to_string())?;
+    rewrite(&bsdf, name)
+}
+
+/// `bsdf` as brtf's Klems writer writes it.
+pub(crate) fn rewrite(bsdf: &brtf_gonio::klems::KlemsBsdf, name: &str) -> Result<String, String> {
+    use brtf_gonio::klems::{KlemsWriteBlock, KlemsWriteHeader, to_klems_xml};
+    let header = KlemsWriteHeader {
+        name: bsdf.header.name.clone().unwrap_or_default(),
+        manufacturer: "brtf-fuzz".into(),
+        thickness_mm: 1.0,
+        device_type: "Other".into(),
+        comment: vec![format!("rewritten from {name} -- by brtf-fuzz")],
+    };
+    let blocks: Vec<KlemsWriteBlock> = bsdf
+        .matrices
+        .iter()
+        .map(|m| KlemsWriteBlock {
+            band: m.band.clone(),
+            direction: m.direction,
+            values: m.values.clone(),
+        })
+        .collect();
+    to_klems_xml(&header, &bsdf.basis, &blocks)
 }
 
 /// The Klems file at `path` resampled to the Quarter basis, as XML text.

@@ -46,6 +46,34 @@ pub fn exercise(target: Target, name: &str, bytes: &[u8]) -> Outcome {
         Target::DetectedGonio => gonio(bytes, name, None),
         Target::Rad => rad(bytes, name),
         Target::FitJson => fit_json(bytes, name),
+        Target::Klems => match klems(bytes, name) {
+            Outcome::Accepted => klems_round_trip(bytes, name),
+            other => other,
+        },
+    }
+}
+
+/// An accepted Klems file written by brtf's writer reads back with the
+/// same matrices.
+fn klems_round_trip(bytes: &[u8], name: &str) -> Outcome {
+    let Ok(bsdf) = brtf_gonio::klems::read_bytes(bytes, name) else {
+        return Outcome::Accepted; // checked by `klems` already
+    };
+    let written = match crate::seeds::rewrite(&bsdf, name) {
+        Ok(w) => w,
+        Err(e) => return anomaly("accepted Klems file cannot be written", e),
+    };
+    match brtf_gonio::klems::read_str(&written, name) {
+        Ok(again) if again.matrices.len() == bsdf.matrices.len() => Outcome::Accepted,
+        Ok(again) => anomaly(
+            "written Klems file reads back other matrices",
+            format!(
+                "{} matrices read back as {}",
+                bsdf.matrices.len(),
+                again.matrices.len()
+            ),
+        ),
+        Err(e) => anomaly("written Klems file does not read back", e.to_string()),
     }
 }
 
@@ -88,7 +116,10 @@ fn klems(bytes: &[u8], name: &str) -> Outcome {
         Ok(b) => b,
         Err(e) => {
             let message = e.to_string();
-            let lines = line_count(bytes, false);
+            // The XML parser counts `\n` only, the text check lone `\r`
+            // too (as editors do): a line is outside the file only when it
+            // is beyond both counts.
+            let lines = line_count(bytes, true);
             return match e.line() {
                 Some(line) if line == 0 || line > lines => anomaly(
                     "error line outside the file",

@@ -56,6 +56,22 @@ fn measurement_and_rad_parsers_survive_20000_mutated_inputs() {
     );
 }
 
+/// The Klems XML reader: no panic, no hang, every error inside the file,
+/// and what it accepts brtf's writer writes and it reads back.
+#[test]
+fn klems_reader_survives_20000_mutated_inputs() {
+    let config = config(&[Target::Klems]);
+    let report = run(&seeds(), &config);
+    let text = format_report(&report, &config);
+    println!("{text}");
+    assert_eq!(report.cases, 20_000);
+    assert!(report.panics.is_empty(), "{text}");
+    assert!(report.hangs.is_empty(), "{text}");
+    assert!(report.anomalies.is_empty(), "{text}");
+    let stats = &report.per_target[&Target::Klems];
+    assert!(stats.accepted > 0 && stats.rejected > 0, "{text}");
+}
+
 #[test]
 fn fit_json_reader_survives_20000_mutated_inputs() {
     let config = config(&[Target::FitJson]);
