@@ -66,9 +66,8 @@ pub(crate) struct KlemsArgs {
     /// Add CIE-X and CIE-Z bands (colour).
     #[arg(long, requires = "klems")]
     pub xyz_bands: bool,
-    /// With --klems --material: also write `<name>-bsdf2klems.cal`, the
-    /// material's BSDF (CIE Y) as the six-argument function
-    /// `bsdf2klems -f` takes, for an independent Klems file from Radiance.
+    /// With --material: also write `<name>-bsdf2klems.cal`, its BSDF (CIE Y)
+    /// for `bsdf2klems -f`: an independent Klems file from Radiance.
     #[arg(long, requires = "material")]
     pub klems_cal: bool,
     /// `Manufacturer` in the Klems file.
@@ -77,6 +76,18 @@ pub(crate) struct KlemsArgs {
     /// `Thickness` in the Klems file, millimetres.
     #[arg(long, value_name = "MM", default_value_t = 1.0, requires = "klems")]
     pub thickness: f64,
+    /// `PermeabilityFactor` in the Klems file: the open fraction, 0 to 1.
+    #[arg(long, value_name = "F", requires = "klems")]
+    pub permeability: Option<f64>,
+    /// `EmissivityFront`, `EmissivityBack` (WINDOW's sides) in the Klems file.
+    #[arg(long, value_name = "FRONT,BACK", requires = "klems", value_parser = brtf_workflow::parse_numbers::<2>)]
+    pub emissivity: Option<[f64; 2]>,
+    /// `TIR` in the Klems file: the infrared transmittance, 0 to 1.
+    #[arg(long, value_name = "T", requires = "klems")]
+    pub ir_transmittance: Option<f64>,
+    /// `ThermalConductivity` in the Klems file, W/(m·K).
+    #[arg(long, value_name = "K", requires = "klems")]
+    pub conductivity: Option<f64>,
     /// `DeviceType` in the Klems file (WINDOW: Other, Woven, Venetian, ...).
     #[arg(long, default_value = "Other", requires = "klems")]
     pub device_type: String,
@@ -111,8 +122,13 @@ fn run_klems(args: &ExportArgs, basis: BasisSize) -> Result<()> {
     options.manufacturer = k.manufacturer.clone();
     options.thickness_mm = k.thickness;
     options.device_type = k.device_type.clone();
+    options.window = brtf_gonio::klems::WindowFields {
+        conductivity: k.conductivity,
+        emissivity: k.emissivity,
+        ir_transmittance: k.ir_transmittance,
+        permeability: k.permeability,
+    };
     options.command_line = super::fit::command_line();
-
     let Some(material_path) = &k.material else {
         let dir = args
             .dir

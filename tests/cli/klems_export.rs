@@ -691,10 +691,18 @@ for method in ("PHOTOPIC", "SOLAR"):
 print(json.dumps(out))
 "#;
 
+/// The thermal fields of a Klems file as pyWinCalc reads them.
+const PYWINCALC_FIELDS: &str = r#"
+import sys, pywincalc
+l = pywincalc.parse_bsdf_xml_file(sys.argv[1])
+print(l.permeability_factor, l.emissivity_front, l.emissivity_back, l.ir_transmittance, l.conductivity)
+"#;
+
 /// pyWinCalc reads brtf's Klems files (comma-separated rows and a Solar
 /// band, as WINDOW writes them) and computes brtf's own totals to 0.5 %:
-/// WINDOW's front is Radiance's back (`docs/klems.md`). `--solar none`
-/// leaves the band out, and pyWinCalc then cannot build the system.
+/// WINDOW's front is Radiance's back (`docs/klems.md`). WINDOW's thermal
+/// fields come through; `--solar none` leaves the band out, and pyWinCalc
+/// then cannot build the system.
 #[test]
 fn pywincalc_reads_the_files_and_computes_brtfs_totals() {
     let Some(python) = pywincalc_python() else {
@@ -768,6 +776,45 @@ fn pywincalc_reads_the_files_and_computes_brtfs_totals() {
             }
         }
     }
+    // WINDOW's thermal fields, as pyWinCalc reads them.
+    let fields = export(
+        &[
+            "--permeability",
+            "0.05",
+            "--emissivity",
+            "0.84,0.8",
+            "--ir-transmittance",
+            "0.1",
+            "--conductivity",
+            "0.15",
+        ],
+        "fields",
+    );
+    let read = std::process::Command::new(&python)
+        .args(["-c", PYWINCALC_FIELDS, s(&fields)])
+        .output()
+        .expect("python runs");
+    let text = String::from_utf8_lossy(&read.stdout);
+    assert_eq!(text.trim(), "0.05 0.84 0.8 0.1 0.15", "{read:?}");
+    let info = brtf(&["info", s(&fields)], "").ok();
+    assert!(info.contains("  PermeabilityFactor 0.05"), "{info}");
+    let err = brtf(
+        &[
+            "export",
+            "--klems",
+            "--material",
+            s(&material),
+            "--emissivity",
+            "0.95,0.9",
+            "--ir-transmittance",
+            "0.1",
+            "--out",
+            s(&dir.path().join("bad")),
+        ],
+        "",
+    )
+    .err();
+    assert!(err.contains("their sum exceeds 1"), "{err}");
     let bare = export(&["--solar", "none"], "bare");
     assert!(!std::fs::read_to_string(&bare).unwrap().contains(">Solar<"));
     assert!(

@@ -96,7 +96,7 @@ fn the_front_ends_stay_thin() {
     };
     let cli = lines("src");
     let total: usize = cli.iter().map(|(_, n)| n).sum();
-    assert!(total <= 1500, "src/ has {total} lines");
+    assert!(total <= 1525, "src/ has {total} lines");
     for (file, n) in &cli {
         assert!(*n <= 250, "{} has {n} lines", file.display());
     }

@@ -371,6 +371,7 @@ pub(crate) fn rewrite(bsdf: &brtf_gonio::klems::KlemsBsdf, name: &str) -> Result
         manufacturer: "brtf-fuzz".into(),
         thickness_mm: 1.0,
         device_type: "Other".into(),
+        window: Default::default(),
         comment: vec![format!("rewritten from {name} -- by brtf-fuzz")],
     };
     let blocks: Vec<KlemsWriteBlock> = bsdf

@@ -59,3 +59,13 @@ fn short(text: &str) -> String {
         None => text.to_string(),
     }
 }
+
+/// `N` comma-separated numbers (`x,y,z`, `front,back`): a command-line
+/// value.
+pub fn parse_numbers<const N: usize>(text: &str) -> Result<[f64; N], String> {
+    let numbers: Result<Vec<f64>, _> = text.split(',').map(|x| x.trim().parse::<f64>()).collect();
+    numbers
+        .ok()
+        .and_then(|v| v.try_into().ok())
+        .ok_or_else(|| format!("{text}: give {N} comma-separated numbers"))
+}

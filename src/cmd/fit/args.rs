@@ -51,8 +51,8 @@ pub(crate) struct FitArgs {
     pub source_omega: f64,
     /// Orientation vector of the *2 models, `x,y,z` [default: fitted, the
     /// in-plane angle `orient`; +x for Klems XML].
-    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
-    pub orientation: Option<Vec<f64>>,
+    #[arg(long, value_parser = brtf_workflow::parse_numbers::<3>, allow_hyphen_values = true)]
+    pub orientation: Option<[f64; 3]>,
     /// Specular lobes over the one diffuse base, 1 to 3 (plastic, metal,
     /// plastic2, metal2): exported as a mixfunc of one primitive per lobe.
     #[arg(long, default_value_t = 1)]
@@ -141,19 +141,12 @@ impl FitArgs {
         let Some(model) = self.model else {
             anyhow::bail!("--model is needed to fit measurement files");
         };
-        let orientation = match &self.orientation {
-            None => None,
-            Some(v) => match <[f64; 3]>::try_from(&v[..]) {
-                Ok(o) => Some(o),
-                _ => anyhow::bail!("--orientation needs three numbers x,y,z"),
-            },
-        };
         Ok(FitSettings {
             gray: self.gray,
             variant: self.formula.variant,
             fresnel_k: self.formula.fresnel_k,
             source_omega: self.source_omega,
-            orientation,
+            orientation: self.orientation,
             lobes: self.lobes,
             residual: self.residual,
             floor: self.floor,

@@ -36,7 +36,7 @@ pub use model_matrix::{
     DEFAULT_SAMPLES, SampleOptions, SideMatrices, band_values, light_vector, side_matrices,
 };
 pub use read::{read_bytes, read_path, read_str};
-pub use write::{KlemsWriteBlock, KlemsWriteHeader, to_klems_xml};
+pub use write::{KlemsWriteBlock, KlemsWriteHeader, WindowFields, to_klems_xml};
 
 /// Values below this are refused; values between it and 0 read as 0.
 pub const NEGATIVE_LIMIT: f64 = -1e-3;
@@ -579,6 +579,7 @@ impl KlemsBsdf {
             thickness: self.header.thickness.clone(),
             thickness_unit: self.header.thickness_unit.clone(),
             device_type: self.header.device_type.clone(),
+            material_fields: self.header.other.clone(),
             basis: self.basis.name.clone(),
             patches: self.basis.len(),
             incident_data_structure: self.incident_data_structure.clone(),
@@ -647,6 +648,9 @@ pub struct KlemsInfo {
     pub thickness_unit: Option<String>,
     /// `DeviceType`.
     pub device_type: Option<String>,
+    /// The other `Material` fields (`ThermalConductivity`, `EmissivityFront`,
+    /// `PermeabilityFactor`, …), in file order.
+    pub material_fields: Vec<(String, String)>,
     /// The basis name.
     pub basis: String,
     /// Its number of patches.
@@ -676,6 +680,9 @@ impl fmt::Display for KlemsInfo {
         };
         writeln!(f, "thickness     {thickness}")?;
         writeln!(f, "device type   {}", text(&self.device_type))?;
+        for (key, value) in &self.material_fields {
+            writeln!(f, "  {key} {value}")?;
+        }
         writeln!(
             f,
             "basis         {} ({} patches, {})",

@@ -30,8 +30,75 @@ pub struct KlemsWriteHeader {
     pub thickness_mm: f64,
     /// `DeviceType` (WINDOW knows e.g. `Other`, `Venetian`, `Woven`).
     pub device_type: String,
+    /// The thermal fields WINDOW and EnergyPlus read, when given.
+    pub window: WindowFields,
     /// Lines of the leading XML comment (provenance, assumptions).
     pub comment: Vec<String>,
+}
+
+/// The optional `Material` fields of WINDOW's heat balance.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct WindowFields {
+    /// `ThermalConductivity`, W/(m·K).
+    pub conductivity: Option<f64>,
+    /// `EmissivityFront`, `EmissivityBack` (WINDOW's sides: its front is
+    /// Radiance's back).
+    pub emissivity: Option<[f64; 2]>,
+    /// `TIR`: the infrared transmittance.
+    pub ir_transmittance: Option<f64>,
+    /// `PermeabilityFactor`: the open fraction of the layer.
+    pub permeability: Option<f64>,
+}
+
+impl WindowFields {
+    /// Checks the ranges, naming the option: a conductivity > 0, the
+    /// others in [0, 1], and emissivity + IR transmittance ≤ 1 on each
+    /// side (what is neither is reflected).
+    pub fn validate(&self) -> Result<(), String> {
+        let fraction = |option: &str, v: f64| -> Result<(), String> {
+            if (0.0..=1.0).contains(&v) {
+                Ok(())
+            } else {
+                Err(format!("{option} {v}: out of range; allowed: 0 to 1"))
+            }
+        };
+        if let Some(k) = self.conductivity
+            && !(k.is_finite() && k > 0.0)
+        {
+            return Err(format!(
+                "--conductivity {k}: out of range; allowed: > 0 W/(m·K)"
+            ));
+        }
+        for e in self.emissivity.into_iter().flatten() {
+            fraction("--emissivity", e)?;
+        }
+        if let Some(t) = self.ir_transmittance {
+            fraction("--ir-transmittance", t)?;
+            for e in self.emissivity.into_iter().flatten() {
+                if e + t > 1.0 + 1e-12 {
+                    return Err(format!(
+                        "--emissivity {e} with --ir-transmittance {t}: their sum exceeds 1"
+                    ));
+                }
+            }
+        }
+        if let Some(p) = self.permeability {
+            fraction("--permeability", p)?;
+        }
+        Ok(())
+    }
+
+    /// The elements, in the order WINDOW writes them.
+    fn elements(&self) -> Vec<(&'static str, f64)> {
+        let mut out = Vec::new();
+        out.extend(self.conductivity.map(|k| ("ThermalConductivity", k)));
+        if let Some([front, back]) = self.emissivity {
+            out.extend([("EmissivityFront", front), ("EmissivityBack", back)]);
+        }
+        out.extend(self.ir_transmittance.map(|t| ("TIR", t)));
+        out.extend(self.permeability.map(|p| ("PermeabilityFactor", p)));
+        out
+    }
 }
 
 /// One matrix to write.
@@ -148,6 +215,9 @@ pub fn to_klems_xml(
         "\t\t<DeviceType>{}</DeviceType>",
         escape(&header.device_type)
     );
+    for (element, value) in header.window.elements() {
+        let _ = writeln!(o, "\t\t<{element}>{value}</{element}>");
+    }
     o += "\t</Material>\n";
     o += "\t<DataDefinition>\n\t\t<IncidentDataStructure>Columns</IncidentDataStructure>\n";
     o += "\t\t<AngleBasis>\n";
@@ -210,6 +280,42 @@ mod tests {
     use super::*;
 
     #[test]
+    fn window_fields_are_checked() {
+        let ok = WindowFields {
+            conductivity: Some(0.15),
+            emissivity: Some([0.8, 0.7]),
+            ir_transmittance: Some(0.2),
+            permeability: Some(0.0),
+        };
+        assert!(ok.validate().is_ok());
+        for bad in [
+            WindowFields {
+                conductivity: Some(0.0),
+                ..ok
+            },
+            WindowFields {
+                emissivity: Some([1.2, 0.5]),
+                ..ok
+            },
+            WindowFields {
+                ir_transmittance: Some(0.3),
+                ..ok
+            },
+            WindowFields {
+                permeability: Some(-0.1),
+                ..ok
+            },
+            WindowFields {
+                permeability: Some(f64::NAN),
+                ..ok
+            },
+        ] {
+            let err = bad.validate().unwrap_err();
+            assert!(err.starts_with("--"), "{err}");
+        }
+    }
+
+    #[test]
     fn written_files_read_back_with_their_header_and_values() {
         let basis = KlemsBasis::built_in("LBNL/Klems Quarter").unwrap();
         let n = basis.len();
@@ -219,6 +325,12 @@ mod tests {
             manufacturer: "brtf".into(),
             thickness_mm: 1.5,
             device_type: "Other".into(),
+            window: WindowFields {
+                conductivity: Some(0.15),
+                emissivity: Some([0.8, 0.7]),
+                ir_transmittance: Some(0.1),
+                permeability: Some(0.05),
+            },
             comment: vec!["made -- by a test".into()],
         };
         let blocks = vec![
@@ -238,6 +350,22 @@ mod tests {
         assert_eq!(read.header.name.as_deref(), Some("a <test> & 'b'"));
         assert_eq!(read.header.thickness_mm(), Some(1.5));
         assert_eq!(read.header.file_type.as_deref(), Some("BSDF"));
+        let fields: Vec<(&str, &str)> = read
+            .header
+            .other
+            .iter()
+            .map(|(k, v)| (k.as_str(), v.as_str()))
+            .collect();
+        assert_eq!(
+            fields,
+            [
+                ("ThermalConductivity", "0.15"),
+                ("EmissivityFront", "0.8"),
+                ("EmissivityBack", "0.7"),
+                ("TIR", "0.1"),
+                ("PermeabilityFactor", "0.05")
+            ]
+        );
         assert_eq!(read.bands(), vec![KlemsBand::Visible, KlemsBand::Solar]);
         let m = read
             .matrix(&KlemsBand::Visible, KlemsDirection::ReflectionBack)

@@ -64,6 +64,8 @@ pub struct KlemsOptions {
     pub thickness_mm: f64,
     /// `DeviceType`.
     pub device_type: String,
+    /// WINDOW's thermal fields (conductivity, emissivities, …).
+    pub window: brtf_gonio::klems::WindowFields,
     /// The command line that asked for the file (provenance).
     pub command_line: Vec<String>,
 }
@@ -80,6 +82,7 @@ impl KlemsOptions {
             manufacturer: "brtf".into(),
             thickness_mm: 1.0,
             device_type: "Other".into(),
+            window: Default::default(),
             command_line: Vec::new(),
         }
     }
@@ -476,6 +479,10 @@ fn build(
             options.thickness_mm
         )));
     }
+    options
+        .window
+        .validate()
+        .map_err(KlemsExportError::Invalid)?;
     let basis = &options.basis;
     let mut computed: Vec<(Side, SideMatrices)> = Vec::new();
     for (side, model) in &sides {
@@ -592,6 +599,7 @@ fn build(
         manufacturer: options.manufacturer.clone(),
         thickness_mm: options.thickness_mm,
         device_type: options.device_type.clone(),
+        window: options.window,
         comment,
     };
     let text = to_klems_xml(&header, basis, &blocks).map_err(KlemsExportError::Invalid)?;
