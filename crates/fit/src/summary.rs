@@ -172,7 +172,7 @@ fn inputs_by_file(s: &mut String, result: &FitResult) {
 }
 
 /// The smallest and largest of `values`.
-fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
+pub(crate) fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
         (lo.min(v), hi.max(v))
     })

@@ -4,6 +4,7 @@
 //! The summary, the report and the `.rad` header all print it.
 
 use crate::adequacy::{ENERGY_TOLERANCE, GLOSS_WIDTH_TOLERANCE, PEAK_TOLERANCE_DEG};
+use crate::summary::range;
 use crate::{FitReport, FitResult};
 use std::fmt;
 
@@ -44,14 +45,7 @@ pub struct Verdict {
 
 /// `θ_in a–b°` or `θ_in a°` over `reports`.
 fn theta_span(reports: &[&FitReport]) -> String {
-    let lo = reports
-        .iter()
-        .map(|r| r.theta_in)
-        .fold(f64::INFINITY, f64::min);
-    let hi = reports
-        .iter()
-        .map(|r| r.theta_in)
-        .fold(f64::NEG_INFINITY, f64::max);
+    let (lo, hi) = range(reports.iter().map(|r| r.theta_in));
     if hi - lo < 1e-9 {
         format!("θ_in {}°", short(lo))
     } else {
@@ -198,27 +192,14 @@ impl FitResult {
             no_peak,
         );
         let e1s: Vec<f64> = reports.iter().filter_map(|r| r.e1).collect();
-        let e1 = (!e1s.is_empty()).then(|| {
-            (
-                e1s.iter().copied().fold(f64::INFINITY, f64::min),
-                e1s.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-            )
-        });
-        let lo = reports
-            .iter()
-            .map(|r| r.theta_in)
-            .fold(f64::INFINITY, f64::min);
-        let hi = reports
-            .iter()
-            .map(|r| r.theta_in)
-            .fold(f64::NEG_INFINITY, f64::max);
+        let e1 = (!e1s.is_empty()).then(|| range(e1s.into_iter()));
         Verdict {
             aspects: vec![energy, direction, width],
             e1,
             theta_in: if reports.is_empty() {
                 (0.0, 0.0)
             } else {
-                (lo, hi)
+                range(reports.iter().map(|r| r.theta_in))
             },
             incidences: reports.len(),
         }

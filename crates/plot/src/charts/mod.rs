@@ -249,9 +249,13 @@ pub(crate) fn fit_title(name: &str, rest: &str, chart_width: u32) -> String {
     if title_width(&cut(0)) > room {
         return fit_end(&whole, room);
     }
-    // The most characters that fit: the width grows with `keep`, so a
-    // bisection finds it.
-    let (mut fits, mut too_wide) = (0, chars.len());
+    cut(most_that_fit(chars.len(), room, cut))
+}
+
+/// The most characters of `len` that `cut` keeps within `room` pixels:
+/// the width grows with the count, so a bisection finds it.
+fn most_that_fit(len: usize, room: u32, cut: impl Fn(usize) -> String) -> usize {
+    let (mut fits, mut too_wide) = (0, len);
     while too_wide - fits > 1 {
         let mid = (fits + too_wide) / 2;
         if title_width(&cut(mid)) <= room {
@@ -260,7 +264,7 @@ pub(crate) fn fit_title(name: &str, rest: &str, chart_width: u32) -> String {
             too_wide = mid;
         }
     }
-    cut(fits)
+    fits
 }
 
 /// `text`, or as much of its start as fits in `room` pixels with an
@@ -275,16 +279,7 @@ pub(crate) fn fit_end(text: &str, room: u32) -> String {
         s.push(ELLIPSIS);
         s
     };
-    let (mut fits, mut too_wide) = (0, chars.len());
-    while too_wide - fits > 1 {
-        let mid = (fits + too_wide) / 2;
-        if title_width(&cut(mid)) <= room {
-            fits = mid;
-        } else {
-            too_wide = mid;
-        }
-    }
-    cut(fits)
+    cut(most_that_fit(chars.len(), room, cut))
 }
 
 /// Draws the chart's title centred at the top and returns the area below.
