@@ -57,6 +57,11 @@ pub struct CandidateRecord {
     pub collapsed: bool,
     /// Wall time of its fits and folds, milliseconds.
     pub elapsed_ms: f64,
+    /// Its fitted material arguments and free scale per incidence, in
+    /// [`crate::FitResult::incidences`] order (what the report's 3D view
+    /// draws for it; empty in fits written before they were kept).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub fitted: Vec<(Vec<f64>, f64)>,
 }
 
 /// What `--model auto` tried and why it chose what it chose.
@@ -163,6 +168,10 @@ fn judge(
         cost: reports.iter().map(|r| r.cost).sum(),
         collapsed,
         elapsed_ms: started.elapsed().as_secs_f64() * 1e3,
+        fitted: reports
+            .iter()
+            .map(|r| (r.material_args.clone(), r.scale))
+            .collect(),
     };
     Ok(Candidate {
         config,
@@ -320,6 +329,7 @@ mod tests {
             e1_heldout: heldout,
             peak_offset_deg: None,
             cost: 0.0,
+            fitted: Vec::new(),
             collapsed,
             elapsed_ms: 0.0,
         }

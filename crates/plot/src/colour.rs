@@ -10,7 +10,7 @@
 use plotters::style::RGBColor;
 
 /// RdBu anchors from t = −1 (blue) to t = +1 (red).
-const RDBU: [(u8, u8, u8); 11] = [
+pub(crate) const RDBU: [(u8, u8, u8); 11] = [
     (5, 48, 97),
     (33, 102, 172),
     (67, 147, 195),

@@ -25,6 +25,9 @@ pub enum PlotError {
     /// The fit result has no incidence to plot.
     #[error("the fit result has no incidences to plot")]
     NoIncidences,
+    /// No measurement file of the fit could be read again.
+    #[error("no measurement of the fit could be read: {0}")]
+    NoData(String),
     /// plotters failed to draw a chart (a bug, or a font problem).
     #[error("drawing {name}: {message}")]
     Draw {

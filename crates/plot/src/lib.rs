@@ -48,6 +48,7 @@ mod figure;
 mod klems;
 mod prepare;
 mod report;
+mod viewer;
 
 pub use error::PlotError;
 pub use klems::klems_sides_report;
@@ -486,6 +487,7 @@ fn plot(
         incidences: entries,
         warnings: &warnings,
         ratio,
+        view: viewer::html(result, &incs, ratio, "view3d-viewer"),
     });
     // The report is written with the plots' files, once they all rendered.
     let report_path = dir.join("report.html");
@@ -520,6 +522,46 @@ fn plot(
         report: report_path,
         warnings,
     })
+}
+
+/// The report's 3D view of the fit in `dir` as one self-contained HTML
+/// block (styles, data and script inlined), for a notebook cell or a page
+/// of one's own: the measurement files are read again as
+/// [`write_plots`] reads them. Each call's block has an id of its own, so
+/// several can share a page.
+pub fn view_html(
+    dir: &Path,
+    result: &FitResult,
+    options: &PlotOptions,
+) -> Result<String, PlotError> {
+    if result.incidences.is_empty() {
+        return Err(PlotError::NoIncidences);
+    }
+    let tags = prepare::tags(&result.incidences);
+    let loaded: Vec<Result<Incidence, String>> = (0..result.incidences.len())
+        .into_par_iter()
+        .map(|k| prepare::load(result, k, tags[k].clone(), dir, &options.search_dirs))
+        .collect();
+    let incs: Vec<&Incidence> = loaded.iter().filter_map(|l| l.as_ref().ok()).collect();
+    if incs.is_empty() {
+        let why = loaded.into_iter().find_map(Result::err).unwrap_or_default();
+        return Err(PlotError::NoData(why));
+    }
+    let ratio = options
+        .ratio
+        .filter(|r| r.is_finite() && *r > 1.0)
+        .unwrap_or_else(|| auto_ratio(&incs));
+    static VIEWS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let serial = VIEWS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let nanos = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.subsec_nanos());
+    let id = format!("brtf-view-{}-{nanos:x}-{serial}", std::process::id());
+    Ok(format!(
+        "<style>{}</style>{}",
+        viewer::STYLE,
+        viewer::html(result, &incs, ratio, &id)
+    ))
 }
 
 /// `name` then `rest` as `chart`'s title, the name shortened to fit the

@@ -1,7 +1,9 @@
 //! `report.html`: one self-contained page per fit folder that shows every
 //! plot, the parameter table, the exported material text and the
-//! provenance. Plain HTML and CSS, no script, no web font, no remote
-//! resource: it opens offline in any browser. Plots are linked relative
+//! provenance. Plain HTML and CSS, no web font, no remote resource: it
+//! opens offline in any browser. One inlined script draws the 3D view
+//! ([`crate::viewer`]); without it (or without WebGL2) the rest of the
+//! page is unchanged. Plots are linked relative
 //! to the fit folder (`plots/<name>.svg`, with the PNG one click away).
 
 use crate::charts::{fmt, incidence_label};
@@ -39,6 +41,8 @@ pub(crate) struct ReportInput<'a> {
     pub warnings: &'a [String],
     /// Colour-bar ratio of the maps.
     pub ratio: f64,
+    /// The 3D view ([`crate::viewer::html`]).
+    pub view: String,
 }
 
 /// HTML-escapes text.
@@ -502,13 +506,14 @@ pub(crate) fn html(input: &ReportInput) -> String {
         out,
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
          <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n\
-         <link rel=\"icon\" href=\"data:,\">\n<title>{}</title>\n<style>{STYLE}{}</style>\n</head>\n<body>\n",
+         <link rel=\"icon\" href=\"data:,\">\n<title>{}</title>\n<style>{STYLE}{}{}</style>\n</head>\n<body>\n",
         esc(&title),
         if result.auto.is_some() {
             AUTO_STYLE
         } else {
             ""
-        }
+        },
+        crate::viewer::STYLE
     );
     let _ = writeln!(out, "<h1>{}</h1>", esc(&title));
     let _ = writeln!(
@@ -528,7 +533,7 @@ pub(crate) fn html(input: &ReportInput) -> String {
     };
     let _ = writeln!(
         out,
-        "<nav><a href=\"#parameters\">Parameters</a>{auto_link}<a href=\"#theta\">Over θ_in</a>\
+        "<nav><a href=\"#parameters\">Parameters</a>{auto_link}<a href=\"#view3d\">3D view</a><a href=\"#theta\">Over θ_in</a>\
          <a href=\"#incidences\">Per incidence</a><a href=\"#material\">Material</a>\
          <a href=\"#provenance\">Provenance</a></nav>",
     );
@@ -565,6 +570,17 @@ pub(crate) fn html(input: &ReportInput) -> String {
     if let Some(auto) = &result.auto {
         auto_section(&mut out, auto);
     }
+
+    out.push_str(
+        "<section id=\"view3d\"><h2>3D view</h2>\n<p class=\"muted\">Every sample of the \
+         file as a point over the hemisphere, seen from the side: the disk is the equal-area \
+         projection of the maps below (reflection above it, transmission below), the height \
+         the value. The translucent surface is the fitted model over the directions the scan \
+         covers. Colour shows the data, the model, or model ÷ data on the maps' scale; grey \
+         points were removed by a selection.</p>\n",
+    );
+    out.push_str(&input.view);
+    out.push_str("</section>\n");
 
     out.push_str("<section id=\"theta\"><h2>Over θ_in</h2>\n");
     if result.incidences.len() < 2 {

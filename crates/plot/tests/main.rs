@@ -9,3 +9,4 @@ mod common;
 mod charts;
 mod lobes;
 mod report;
+mod view;

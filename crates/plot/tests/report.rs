@@ -40,7 +40,10 @@ fn the_report_references_every_plot_and_has_no_broken_link() {
         assert!(html.contains(&format!("src=\"plots/map-{tag}.svg\"")));
         assert!(html.contains(&format!("href=\"plots/cut-{tag}.png\"")));
     }
-    assert!(!html.contains("<script"), "no script needed");
+    // One inlined script, the 3D view's; nothing is fetched.
+    assert_eq!(html.matches("<script>").count(), 1);
+    assert!(!html.contains("<script src"));
+    assert!(!html.contains("import("));
 }
 
 #[test]
