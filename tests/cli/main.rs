@@ -22,6 +22,7 @@
 
 mod albedo;
 mod align;
+mod browser;
 mod common;
 mod contract;
 mod eval;
@@ -46,3 +47,4 @@ mod safety;
 mod shadow;
 mod speed;
 mod verdict;
+mod view3d;

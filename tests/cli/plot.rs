@@ -1,26 +1,19 @@
 //! `brtf plot`: the data set's plots and report through the CLI, the report
 //! in a real browser, speed on a real 120 000-point scan, and errors.
 //!
-//! The browser test drives headless Chromium through chromedriver (the
-//! Debian packages `chromium` and `chromium-driver`) over the WebDriver
-//! protocol: it loads `report.html` from disk, fails on any error in the
+//! The browser test drives headless Chromium (see [`crate::browser`]): it
+//! loads `report.html` from disk, fails on any error in the
 //! browser log (console errors and resources that failed to load), checks
 //! that the parameter table is shown and every image decoded, and saves a
 //! screenshot. Without Chromium it warns and skips, except under `CI`,
 //! where it fails.
 
+use crate::browser::{Driver, HEAVY, base64_decode, browser_and_driver, session, severe};
 use crate::common::{brtf, repo_path, s, temp_dir};
-use serde_json::{Value, json};
-use std::io::{Read, Write};
-use std::net::{TcpListener, TcpStream};
+use serde_json::json;
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
-use std::sync::Mutex;
-use std::time::{Duration, Instant};
-
-/// Held by the tests that must not run at the same time: the timing and
-/// the browser.
-static HEAVY: Mutex<()> = Mutex::new(());
+use std::process::Command;
+use std::time::Instant;
 
 /// Fits the `data/alu-ggx` set into `dir/fit` (no plots) and returns the folder.
 fn fit_data_set(dir: &Path) -> PathBuf {
@@ -155,188 +148,9 @@ fn plotting_a_120k_point_scan_takes_under_a_second() {
     assert!(!fit.join("plots/params.png").exists());
 }
 
-/// A program on `PATH`.
-fn which(names: &[&str]) -> Option<PathBuf> {
-    let path = std::env::var_os("PATH")?;
-    names.iter().find_map(|name| {
-        std::env::split_paths(&path)
-            .map(|d| d.join(name))
-            .find(|p| p.is_file())
-    })
-}
-
-/// A chromedriver process, killed when dropped.
-struct Driver {
-    child: Child,
-    port: u16,
-}
-
-impl Drop for Driver {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
-
-impl Driver {
-    fn start(program: &Path) -> Driver {
-        let port = TcpListener::bind("127.0.0.1:0")
-            .and_then(|l| l.local_addr())
-            .map(|a| a.port())
-            .expect("a free port");
-        let child = Command::new(program)
-            .arg(format!("--port={port}"))
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .spawn()
-            .unwrap_or_else(|e| panic!("cannot start {}: {e}", program.display()));
-        let driver = Driver { child, port };
-        let deadline = Instant::now() + Duration::from_secs(20);
-        loop {
-            if let Ok(v) = driver.call("GET", "/status", None)
-                && v["value"]["ready"] == json!(true)
-            {
-                return driver;
-            }
-            assert!(Instant::now() < deadline, "chromedriver did not start");
-            std::thread::sleep(Duration::from_millis(100));
-        }
-    }
-
-    /// One WebDriver request; the JSON response.
-    fn call(&self, method: &str, path: &str, body: Option<Value>) -> Result<Value, String> {
-        let mut stream = TcpStream::connect(("127.0.0.1", self.port)).map_err(|e| e.to_string())?;
-        stream
-            .set_read_timeout(Some(Duration::from_secs(60)))
-            .map_err(|e| e.to_string())?;
-        let body = body.map(|b| b.to_string()).unwrap_or_default();
-        let request = format!(
-            "{method} {path} HTTP/1.1\r\nHost: 127.0.0.1:{}\r\nContent-Type: application/json\r\n\
-             Content-Length: {}\r\nConnection: close\r\n\r\n{body}",
-            self.port,
-            body.len()
-        );
-        stream
-            .write_all(request.as_bytes())
-            .map_err(|e| e.to_string())?;
-        // Read the header, then exactly the body (the server may keep the
-        // connection open).
-        let mut raw = Vec::new();
-        let mut buf = [0u8; 65536];
-        let split = loop {
-            if let Some(p) = raw.windows(4).position(|w| w == b"\r\n\r\n") {
-                break p;
-            }
-            let n = stream.read(&mut buf).map_err(|e| e.to_string())?;
-            if n == 0 {
-                return Err("connection closed before the header".into());
-            }
-            raw.extend_from_slice(&buf[..n]);
-        };
-        let head = String::from_utf8_lossy(&raw[..split]).to_lowercase();
-        let mut payload = raw[split + 4..].to_vec();
-        let length = head
-            .lines()
-            .find_map(|l| l.strip_prefix("content-length:"))
-            .and_then(|v| v.trim().parse::<usize>().ok());
-        let chunked = head.contains("transfer-encoding: chunked");
-        loop {
-            let done = match length {
-                Some(n) => payload.len() >= n,
-                None if chunked => payload.ends_with(b"0\r\n\r\n"),
-                None => false,
-            };
-            if done {
-                break;
-            }
-            let n = stream.read(&mut buf).map_err(|e| e.to_string())?;
-            if n == 0 {
-                break;
-            }
-            payload.extend_from_slice(&buf[..n]);
-        }
-        if chunked {
-            payload = dechunk(&payload)?;
-        }
-        serde_json::from_slice(&payload)
-            .map_err(|e| format!("{e}: {}", String::from_utf8_lossy(&payload)))
-    }
-
-    /// A request that must succeed.
-    fn must(&self, method: &str, path: &str, body: Option<Value>) -> Value {
-        let v = self
-            .call(method, path, body)
-            .unwrap_or_else(|e| panic!("{method} {path}: {e}"));
-        assert!(
-            v["value"].get("error").is_none(),
-            "{method} {path}: {}",
-            v["value"]
-        );
-        v["value"].clone()
-    }
-}
-
-fn dechunk(mut data: &[u8]) -> Result<Vec<u8>, String> {
-    let mut out = Vec::new();
-    loop {
-        let line_end = data
-            .windows(2)
-            .position(|w| w == b"\r\n")
-            .ok_or("bad chunk")?;
-        let size_text = String::from_utf8_lossy(&data[..line_end]);
-        let size = usize::from_str_radix(size_text.trim(), 16).map_err(|e| e.to_string())?;
-        data = &data[line_end + 2..];
-        if size == 0 {
-            return Ok(out);
-        }
-        out.extend_from_slice(data.get(..size).ok_or("short chunk")?);
-        data = data.get(size + 2..).ok_or("short chunk")?;
-    }
-}
-
-fn base64_decode(text: &str) -> Vec<u8> {
-    let value = |c: u8| -> u32 {
-        match c {
-            b'A'..=b'Z' => (c - b'A') as u32,
-            b'a'..=b'z' => (c - b'a' + 26) as u32,
-            b'0'..=b'9' => (c - b'0' + 52) as u32,
-            b'+' => 62,
-            b'/' => 63,
-            _ => panic!("not base64: {c}"),
-        }
-    };
-    let clean: Vec<u8> = text.bytes().filter(|c| !c.is_ascii_whitespace()).collect();
-    let mut out = Vec::new();
-    for chunk in clean.chunks(4) {
-        let digits: Vec<u32> = chunk
-            .iter()
-            .filter(|&&c| c != b'=')
-            .map(|&c| value(c))
-            .collect();
-        let mut n = 0u32;
-        for (k, d) in digits.iter().enumerate() {
-            n |= d << (18 - 6 * k);
-        }
-        for k in 0..digits.len().saturating_sub(1) {
-            out.push((n >> (16 - 8 * k)) as u8);
-        }
-    }
-    out
-}
-
 #[test]
 fn the_report_opens_in_headless_chromium_without_errors() {
-    let browser = which(&["chromium", "chromium-browser", "google-chrome"]);
-    let driver = which(&["chromedriver"]);
-    let (Some(browser), Some(driver)) = (browser, driver) else {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "CI needs Chromium and chromedriver: apt-get install -y chromium chromium-driver"
-        );
-        eprintln!(
-            "WARNING: skipping the browser test: chromium and chromedriver are not on PATH \
-             (apt-get install -y chromium chromium-driver)"
-        );
+    let Some((browser, driver)) = browser_and_driver() else {
         return;
     };
     let dir = temp_dir();
@@ -346,29 +160,7 @@ fn the_report_opens_in_headless_chromium_without_errors() {
 
     let _alone = HEAVY.lock().unwrap_or_else(|e| e.into_inner());
     let driver = Driver::start(&driver);
-    let profile = dir.path().join("chromium-profile");
-    let session = driver.must(
-        "POST",
-        "/session",
-        Some(json!({"capabilities": {"alwaysMatch": {
-            "browserName": "chrome",
-            "goog:chromeOptions": {
-                "binary": s(&browser),
-                "args": [
-                    "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
-                    "--no-first-run", "--disable-background-networking",
-                    "--disable-component-update", "--disable-sync", "--disable-dev-shm-usage",
-                    "--window-size=1280,1000",
-                    format!("--user-data-dir={}", s(&profile)),
-                ]
-            },
-            "goog:loggingPrefs": {"browser": "ALL"}
-        }}})),
-    );
-    let id = session["sessionId"]
-        .as_str()
-        .expect("a session id")
-        .to_string();
+    let id = session(&driver, &browser, &dir.path().join("chromium-profile"), &[]);
     let at = |p: &str| format!("/session/{id}{p}");
     driver.must(
         "POST",
@@ -482,20 +274,10 @@ fn the_report_opens_in_headless_chromium_without_errors() {
     );
     let bad_log = driver.must("POST", &at("/se/log"), Some(json!({"type": "browser"})));
     let _ = driver.call("DELETE", &at(""), None);
-    let bad_errors = bad_log
-        .as_array()
-        .expect("a log")
-        .iter()
-        .filter(|e| e["level"] == json!("SEVERE"))
-        .count();
+    let bad_errors = severe(&bad_log).len();
     assert_eq!(bad_errors, 2, "the log must catch errors: {bad_log:#}");
 
-    let errors: Vec<&Value> = log
-        .as_array()
-        .expect("a log")
-        .iter()
-        .filter(|e| e["level"] == json!("SEVERE"))
-        .collect();
+    let errors = severe(&log);
     assert!(errors.is_empty(), "browser errors: {errors:#?}");
     assert_eq!(state["ready"], json!("complete"), "{state}");
     assert_eq!(state["title"], json!("alu-ggx: brtf fit report"), "{state}");

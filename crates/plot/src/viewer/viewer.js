@@ -152,8 +152,8 @@
   var SURF_FS = ['#version 300 es', 'precision mediump float;', 'in vec3 v_pos; in float v_h; out vec4 o;',
     'void main() { vec3 n = normalize(cross(dFdx(v_pos), dFdy(v_pos)));',
     '  float light = 0.55 + 0.45 * abs(dot(n, normalize(vec3(0.4, -0.5, 0.8))));',
-    '  vec3 c = mix(vec3(0.95, 0.55, 0.25), vec3(0.75, 0.25, 0.05), v_h);',
-    '  o = vec4(c * light, 0.38); }'].join('\n');
+    '  vec3 c = mix(vec3(0.66, 0.69, 0.74), vec3(0.33, 0.38, 0.48), v_h);',
+    '  o = vec4(c * light, 0.3); }'].join('\n');
   var LINE_VS = ['#version 300 es', 'in vec3 a_pos; uniform mat4 u_mvp;',
     'void main() { gl_Position = u_mvp * vec4(a_pos, 1.0); }'].join('\n');
   var LINE_FS = ['#version 300 es', 'precision mediump float;', 'uniform vec4 u_colour; out vec4 o;',
@@ -391,6 +391,7 @@
     }
     gl.bindVertexArray(null);
     hook.draws++;
+    if (!hook.ready) hook.firstDraw = performance.now();
     hook.ready = true;
     root.dataset.draws = hook.draws;
   }
@@ -428,7 +429,7 @@
       '<div><span class="bv-key" style="background:#e69a00"></span>light ' +
       '<span class="bv-key" style="background:#cc0099"></span>mirror</div>' +
       '<div><span class="bv-key" style="background:#9e9e9e;height:8px;width:8px;border-radius:4px"></span>removed by a selection</div>' +
-      (state.surface ? '<div><span class="bv-key" style="background:rgba(230,120,40,0.5);height:8px"></span>surface: ' +
+      (state.surface ? '<div><span class="bv-key" style="background:rgba(90,100,125,0.45);height:8px"></span>surface: ' +
         esc(inc.surfaces[Math.min(state.surfaceOf, inc.surfaces.length - 1)].label) + '</div>' : '');
     legend.innerHTML = html;
     status.textContent = payload.name + ', ' + inc.label + ': ' + inc.n.toLocaleString('en') + ' samples, ' +
