@@ -207,6 +207,8 @@ class Fit:
         klems: Optional[Literal["full", "half", "quarter"]] = None,
         klems_colour: bool = False,
     ) -> list[str]: ...
+    def _repr_html_(self) -> str:
+        """The report's 3D view (data, model, model ÷ data), shown by a notebook."""
 
 # brtf.fit (python/brtf/_python.py, typed in _python.pyi) turns its inputs
 # into the paths and passes its keyword options on.

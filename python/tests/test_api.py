@@ -208,3 +208,18 @@ def test_fit_of_a_klems_side_equals_the_cli(cli, klems_fabric, tmp_path):
         assert got.material_args == pytest.approx(ref["material_args"], rel=1e-12, abs=1e-15)
     with pytest.raises(brtf.ModelError, match="one side at a time"):
         brtf.fit(klems_fabric, model="trans")
+
+
+def test_a_fit_shows_its_3d_view_in_a_notebook(alu_fit, alu, tmp_path):
+    html = alu_fit._repr_html_()
+    assert html.startswith("<style>") and 'class="brtf-view"' in html
+    start = html.index('class="bv-data">') + len('class="bv-data">')
+    view = json.loads(html[start:html.index("</script>", start)].replace("<\\/", "</"))
+    assert [i["n"] for i in view["incidences"]] == [len(brtf.read(p).theta) for p in alu]
+    assert [i["fitted"] for i in view["incidences"]] == [r.n_points for r in alu_fit.incidences]
+    # Two views in one notebook do not share an id.
+    assert html.split('id="')[1].split('"')[0] != alu_fit._repr_html_().split('id="')[1].split('"')[0]
+    # A fit folder read back shows the same samples.
+    alu_fit.save(tmp_path / "fit", plots=False, export=False)
+    again = brtf.Fit.load(tmp_path / "fit")._repr_html_()
+    assert again.count('"n":') == html.count('"n":')

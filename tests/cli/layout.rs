@@ -101,7 +101,7 @@ fn the_front_ends_stay_thin() {
         assert!(*n <= 250, "{} has {n} lines", file.display());
     }
     let py: usize = lines("crates/py/src").iter().map(|(_, n)| n).sum();
-    assert!(py <= 1200, "crates/py/src has {py} lines");
+    assert!(py <= 1250, "crates/py/src has {py} lines");
     // Folder staging, export writing and the manifest live in brtf-workflow.
     for (file, _) in cli.iter().chain(&lines("crates/py/src")) {
         let text = std::fs::read_to_string(file).unwrap();

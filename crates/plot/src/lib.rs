@@ -52,6 +52,8 @@ mod viewer;
 
 pub use error::PlotError;
 pub use klems::klems_sides_report;
+/// HTML-escapes text (`&`, `<`, `>`, `"`, `'`).
+pub use report::esc as escape;
 
 /// The pieces the criterion benches time one by one; not brtf-plot's API.
 #[doc(hidden)]

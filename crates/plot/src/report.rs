@@ -46,7 +46,7 @@ pub(crate) struct ReportInput<'a> {
 }
 
 /// HTML-escapes text.
-pub(crate) fn esc(s: &str) -> String {
+pub fn esc(s: &str) -> String {
     let mut out = String::with_capacity(s.len());
     for c in s.chars() {
         match c {

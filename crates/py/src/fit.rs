@@ -104,11 +104,18 @@ pub struct Fit {
     result: FitResult,
     /// The measurement files, as given.
     paths: Vec<PathBuf>,
+    /// The folder `Fit.load` read (where relative input paths start).
+    folder: Option<PathBuf>,
 }
 
 impl Fit {
     pub(crate) fn new(result: FitResult, paths: Vec<PathBuf>) -> Fit {
-        Fit { result, paths }
+        let folder = None;
+        Fit {
+            result,
+            paths,
+            folder,
+        }
     }
 
     /// The θ_in table, or the error of a fit without one.
@@ -135,7 +142,26 @@ impl Fit {
         let result = result.map_err(errors::read_fit)?;
         let inputs = result.provenance.inputs.iter();
         let paths = inputs.map(|i| PathBuf::from(&i.path)).collect();
-        Ok(Fit { result, paths })
+        let folder = Some(folder);
+        Ok(Fit {
+            result,
+            paths,
+            folder,
+        })
+    }
+
+    /// The report's 3D view of the data against the model, which a
+    /// notebook shows; a line saying why when the files cannot be read.
+    fn _repr_html_(&self, py: Python<'_>) -> String {
+        let dir = self.folder.clone().unwrap_or_else(|| PathBuf::from("."));
+        let options = brtf_plot::PlotOptions::default();
+        let view = py.detach(|| brtf_plot::view_html(&dir, &self.result, &options));
+        view.unwrap_or_else(|e| {
+            format!(
+                "<p>brtf: no 3D view: {}</p>",
+                brtf_plot::escape(&e.to_string())
+            )
+        })
     }
 
     /// The material name.
