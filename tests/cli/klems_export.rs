@@ -586,6 +586,17 @@ fn anisotropic_fit_exports_the_parameters_of_each_azimuth() {
     );
     // At each fitted incidence the table gives that incidence's own fit.
     let result = brtf_fit::FitResult::read(&fit_dir).unwrap();
+    // So many incidences' maps and cuts load when scrolled to, and the 3D
+    // view holds every incidence behind one picker.
+    assert_eq!(
+        report.matches("loading=\"lazy\"").count(),
+        2 * result.incidences.len()
+    );
+    assert_eq!(report.matches("class=\"brtf-view\"").count(), 1);
+    assert_eq!(
+        report.matches("\"samples\":").count(),
+        result.incidences.len()
+    );
     for r in &result.incidences {
         let m = result
             .material_at_direction(r.theta_in, r.phi_in, None)

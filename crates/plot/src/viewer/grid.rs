@@ -10,8 +10,13 @@ use brtf_model::CompositeBsdf;
 use glam::DVec3;
 use rayon::prelude::*;
 
-/// Nodes per side of the grid (odd: one node at the centre).
-pub(crate) const SIZE: usize = 97;
+/// Nodes per side of the grid of an incidence of `samples` samples: odd
+/// (one node at the centre), about 1.2 √n, from 25 (a Klems basis) to 97
+/// (a dense scan), so that a sparse scan's surfaces stay small.
+pub(crate) fn size(samples: usize) -> usize {
+    let side = (1.2 * (samples as f64).sqrt()).round() as usize;
+    side.clamp(25, 97) | 1
+}
 
 /// The hemispheres that hold fitted samples, front first (the front
 /// alone when none does): where a surface is drawn.
@@ -100,20 +105,21 @@ pub(crate) fn surface(
     lo: f64,
     hi: f64,
 ) -> Vec<u8> {
-    let mut bytes = Vec::with_capacity(2 * SIZE * SIZE * hemispheres.len());
+    let size = size(inc.samples.len());
+    let mut bytes = Vec::with_capacity(2 * size * size * hemispheres.len());
     for &hemisphere in hemispheres {
         let (side, occupied) = occupancy(inc, hemisphere);
         let at = |k: usize| -> u16 {
-            let (i, j) = (k % SIZE, k / SIZE);
-            let u = -1.0 + 2.0 * i as f64 / (SIZE - 1) as f64;
-            let v = -1.0 + 2.0 * j as f64 / (SIZE - 1) as f64;
+            let (i, j) = (k % size, k / size);
+            let u = -1.0 + 2.0 * i as f64 / (size - 1) as f64;
+            let v = -1.0 + 2.0 * j as f64 / (size - 1) as f64;
             let cell = |w: f64| (((w + 1.0) * 0.5 * side as f64) as usize).min(side - 1);
             match direction(u, v, hemisphere) {
                 Some(dir) if occupied[cell(v) * side + cell(u)] => encode(model(dir), lo, hi),
                 _ => NONE,
             }
         };
-        let codes: Vec<u16> = (0..SIZE * SIZE).into_par_iter().map(at).collect();
+        let codes: Vec<u16> = (0..size * size).into_par_iter().map(at).collect();
         bytes.extend(codes.iter().flat_map(|c| c.to_le_bytes()));
     }
     bytes

@@ -166,7 +166,7 @@ fn incidence_json(result: &FitResult, inc: &Incidence) -> Value {
         "light": marker(inc.light),
         "mirror": marker(inc.mirror()),
         "through": marker(through),
-        "grid": grid::SIZE,
+        "grid": grid::size(n),
         "hemispheres": hemispheres.iter().map(|h| if *h == Hemisphere::Back { -1 } else { 1 }).collect::<Vec<_>>(),
         "samples": base64(&bytes),
         "surfaces": surfaces,

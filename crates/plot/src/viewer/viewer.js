@@ -226,9 +226,12 @@
     gl.deleteVertexArray(d.vao);
     d.surfaces.forEach(function (s) { gl.deleteBuffer(s.codes); gl.deleteBuffer(s.index); gl.deleteVertexArray(s.vao); });
   }
-  var G = incidences[0].grid;
+  // The surfaces' grid of G × G nodes over the unit disk (G per incidence).
+  var G = 0;
   var gridBuffer = gl.createBuffer();
-  (function () {
+  function makeGrid(size) {
+    if (size === G) return;
+    G = size;
     var uv = new Float32Array(2 * G * G);
     for (var j = 0; j < G; j++) {
       for (var i = 0; i < G; i++) {
@@ -238,9 +241,10 @@
     }
     gl.bindBuffer(gl.ARRAY_BUFFER, gridBuffer);
     gl.bufferData(gl.ARRAY_BUFFER, uv, gl.STATIC_DRAW);
-  })();
+  }
   function loadSurface() {
     var d = current;
+    makeGrid(d.inc.grid);
     d.surfaces.forEach(function (s) { gl.deleteBuffer(s.codes); gl.deleteBuffer(s.index); gl.deleteVertexArray(s.vao); });
     d.surfaces = [];
     var which = Math.min(state.surfaceOf, d.inc.surfaces.length - 1);
