@@ -133,6 +133,30 @@ fn auto_lobe_sums_plot_the_composite_and_the_report_shows_e1_and_the_candidates(
     }
     let reason = auto.reason.replace('\'', "&#39;");
     assert!(html.contains(&reason), "the reason sentence");
+    // The 3D view offers the chosen fit's surface, then every other
+    // candidate's, each from its own fitted arguments.
+    let view = crate::view::payload(&html);
+    for inc in view["incidences"].as_array().unwrap() {
+        let surfaces = inc["surfaces"].as_array().unwrap();
+        let labels: Vec<&str> = surfaces
+            .iter()
+            .map(|s| s["label"].as_str().unwrap())
+            .collect();
+        let mut expected = vec![format!("{} (fitted)", shape.label())];
+        for (i, c) in auto.candidates.iter().enumerate() {
+            if i != auto.chosen {
+                expected.push(c.model.clone());
+            }
+        }
+        assert_eq!(labels, expected);
+        let codes: Vec<&str> = surfaces
+            .iter()
+            .map(|s| s["codes"].as_str().unwrap())
+            .collect();
+        for other in &codes[1..] {
+            assert_ne!(*other, codes[0], "a candidate's surface is the chosen one's");
+        }
+    }
     for l in links(&html).iter().filter(|l| l.starts_with("plots/")) {
         assert!(from_files.path().join(percent_decode(l)).is_file(), "{l}");
     }

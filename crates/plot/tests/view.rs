@@ -8,7 +8,7 @@ use brtf_plot::bench::load;
 use serde_json::Value;
 
 /// The JSON block of the first view in `html`.
-fn payload(html: &str) -> Value {
+pub(crate) fn payload(html: &str) -> Value {
     let start = html.find("class=\"bv-data\">").expect("a view") + "class=\"bv-data\">".len();
     let end = start + html[start..].find("</script>").unwrap();
     serde_json::from_str(&html[start..end].replace("<\\/", "</")).expect("JSON")
