@@ -2,7 +2,9 @@
 """Opens report.html files in headless Chromium (software WebGL, through
 chromedriver) and prints, per file: its size, the 3D view's share of it,
 the load event and the view's first frame (milliseconds after navigation
-start, the median of three loads in a fresh tab each time).
+start), and the time to draw one frame (the mean of 20) at rest and while
+the view turns (a subsample of at most about 30 000 points), each the
+median of three loads.
 
     python3 scripts/report-open-time.py fits/alu-ggx/report.html other/report.html
 
@@ -52,11 +54,17 @@ def main(paths):
             (function poll() {
                 const v = document.querySelector('.brtf-view');
                 if (v && v.brtfView && v.brtfView.ready) {
+                    const time = (turning) => {
+                        const t = performance.now();
+                        for (let k = 0; k < 20; k++) v.brtfView.frame(turning);
+                        return (performance.now() - t) / 20;
+                    };
                     done({load: performance.getEntriesByType('navigation')[0].loadEventEnd,
-                          first: v.brtfView.firstDraw ?? null, view: v.outerHTML.length});
+                          first: v.brtfView.firstDraw ?? null, view: v.outerHTML.length,
+                          frame: time(false), turning: time(true)});
                 } else if (performance.now() - t0 > 20000) { done(null); } else { setTimeout(poll, 20); }
             })();"""
-        print(f"{'file':<50} {'MB':>6} {'view MB':>8} {'load ms':>8} {'3D ms':>7}")
+        print(f"{'file':<50} {'MB':>6} {'view MB':>8} {'load ms':>8} {'3D ms':>7} {'frame ms':>9} {'turning ms':>11}")
         for path in paths:
             url = "file://" + os.path.abspath(path)
             runs = []
@@ -70,7 +78,9 @@ def main(paths):
             size = os.path.getsize(path) / 1e6
             load = statistics.median(r["load"] for r in runs)
             first = statistics.median(r["first"] for r in runs)
-            print(f"{path:<50} {size:6.2f} {runs[0]['view'] / 1e6:8.2f} {load:8.0f} {first:7.0f}")
+            frame = statistics.median(r["frame"] for r in runs)
+            turning = statistics.median(r["turning"] for r in runs)
+            print(f"{path:<50} {size:6.2f} {runs[0]['view'] / 1e6:8.2f} {load:8.0f} {first:7.0f} {frame:9.1f} {turning:11.1f}")
         call("DELETE", at(""))
     finally:
         driver.kill()

@@ -154,7 +154,10 @@ fn auto_lobe_sums_plot_the_composite_and_the_report_shows_e1_and_the_candidates(
             .map(|s| s["codes"].as_str().unwrap())
             .collect();
         for other in &codes[1..] {
-            assert_ne!(*other, codes[0], "a candidate's surface is the chosen one's");
+            assert_ne!(
+                *other, codes[0],
+                "a candidate's surface is the chosen one's"
+            );
         }
     }
     for l in links(&html).iter().filter(|l| l.starts_with("plots/")) {
