@@ -42,6 +42,12 @@ echo "== cargo clippy"
 cargo clippy --workspace --all-targets --quiet -- -D warnings
 echo "== cargo test"
 mkdir -p target
+# No test may change an input: every tracked file and every file of
+# ../shared/data is hashed now and checked after the last test.
+{
+    git ls-files -z 2>/dev/null | xargs -0 -r sha256sum
+    find ../shared/data -type f -print0 2>/dev/null | sort -z | xargs -0 -r sha256sum
+} > target/inputs.sha256
 set +e
 cargo test --workspace 2>&1 | tee target/test-output.log
 status=${PIPESTATUS[0]}
@@ -73,4 +79,9 @@ if [ "$python_status" -eq 0 ]; then
         || python_status=$?
 fi
 [ "$status" -ne 0 ] || status=$python_status
+echo "== inputs unchanged (SHA-256 of $(wc -l < target/inputs.sha256) files)"
+if ! sha256sum --quiet --check target/inputs.sha256; then
+    echo "a test changed the inputs above"
+    status=1
+fi
 exit "$status"

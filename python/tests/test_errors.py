@@ -137,8 +137,9 @@ def test_directions_out_of_range_raise():
 
 def test_ctrl_c_stops_a_running_fit(klems_fabric):
     # A long fit (a Klems side, 512 directions per patch, one thread: ~28 s)
-    # in a child interpreter; SIGINT once the incidences are being fitted
-    # raises KeyboardInterrupt at the next incidence, within seconds.
+    # in a child interpreter; SIGINT while the incidences are being fitted
+    # stops the solve under way and raises KeyboardInterrupt within a
+    # second.
     code = """
 import sys, time, brtf
 print("started", flush=True)
@@ -157,4 +158,5 @@ except KeyboardInterrupt:
     out, _ = child.communicate(timeout=60)
     after = time.monotonic() - signalled
     assert out.split()[0] == "interrupted", out
-    assert after < 3.0, f"{out}: {after:.1f} s after the signal"
+    assert after < 1.0, f"{out}: {after:.2f} s after the signal"
+    print(f"interrupted {after:.3f} s after SIGINT")

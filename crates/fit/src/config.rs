@@ -152,6 +152,50 @@ pub struct FitConfig {
     /// (`orient`), not fixed by `orientation`.
     #[serde(default)]
     pub oriented: bool,
+    /// Raised by the caller to stop the fit (Ctrl-C in Python): each
+    /// solve ends at its next evaluation. Not part of what decides a fit.
+    #[serde(skip)]
+    pub stop: StopFlag,
+}
+
+/// A request to stop running fits early, shared between the caller and
+/// the solver: every clone sees the same flag. The default is a flag
+/// nobody can raise.
+#[derive(Clone, Default)]
+pub struct StopFlag(Option<std::sync::Arc<std::sync::atomic::AtomicBool>>);
+
+impl StopFlag {
+    /// A flag that [`StopFlag::raise`] raises.
+    pub fn new() -> StopFlag {
+        StopFlag(Some(Default::default()))
+    }
+
+    /// Asks every fit holding a clone of this flag to stop.
+    pub fn raise(&self) {
+        if let Some(flag) = &self.0 {
+            flag.store(true, std::sync::atomic::Ordering::Relaxed);
+        }
+    }
+
+    /// The stop was asked for.
+    pub fn is_raised(&self) -> bool {
+        self.0
+            .as_ref()
+            .is_some_and(|flag| flag.load(std::sync::atomic::Ordering::Relaxed))
+    }
+}
+
+/// Flags never make two configurations differ.
+impl PartialEq for StopFlag {
+    fn eq(&self, _: &StopFlag) -> bool {
+        true
+    }
+}
+
+impl std::fmt::Debug for StopFlag {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "StopFlag({})", self.is_raised())
+    }
 }
 
 fn default_min_roughness() -> f64 {
@@ -178,6 +222,7 @@ impl FitConfig {
             min_roughness: crate::MIN_ROUGHNESS,
             lobes: 1,
             oriented: false,
+            stop: StopFlag::default(),
         }
     }
 

@@ -203,6 +203,8 @@ pub(crate) struct Problem<'a> {
     /// The large-residual correction of LM's Hessian, when the stage uses
     /// one (see [`Secant`]).
     pub secant: Option<RefCell<Secant>>,
+    /// The caller's stop request: no pass runs once it is raised.
+    pub stop: crate::StopFlag,
 }
 
 impl<'a> Problem<'a> {
@@ -228,6 +230,7 @@ impl<'a> Problem<'a> {
             report: false,
             history: RefCell::new(Vec::new()),
             secant: None,
+            stop: config.stop.clone(),
         }
     }
 
@@ -1214,6 +1217,11 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
 impl Problem<'_> {
     /// The compressed problem at `u`, from the history or a new pass.
     pub(crate) fn evaluated(&self, u: &DVector<f64>) -> Option<Compressed> {
+        // A stopped fit ends here: Levenberg-Marquardt stops at residuals
+        // it cannot have.
+        if self.stop.is_raised() {
+            return None;
+        }
         let known = self
             .history
             .borrow()

@@ -586,6 +586,10 @@ fn fit_all(
                         return Err(FitError::Interrupted);
                     }
                     let r = fit_incidence_sharing(d, config, &geometry[i]);
+                    // A fit stopped inside its solve ended anywhere.
+                    if progress.cancelled() || config.stop.is_raised() {
+                        return Err(FitError::Interrupted);
+                    }
                     progress.advance();
                     r
                 })
@@ -602,6 +606,9 @@ fn fit_all(
                 return Some(Err(FitError::Interrupted));
             }
             let r = fit_global_sharing(data, config, geometry);
+            if progress.cancelled() || config.stop.is_raised() {
+                return Some(Err(FitError::Interrupted));
+            }
             progress.advance();
             Some(r)
         },

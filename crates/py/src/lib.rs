@@ -12,7 +12,6 @@ mod measurement;
 use brtf_gonio::klems::{Side, Sides};
 use brtf_workflow::{FitInputs, FitJob, WorkflowError};
 use pyo3::prelude::*;
-use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Fits a Radiance model to the measurement files `paths`, as `brtf fit`
 /// does: one fit per incidence, one for all, and the θ_in table (`brtf.fit`
@@ -99,6 +98,7 @@ fn fit_set(
             })
             .transpose()?,
         patch_samples,
+        stop: brtf_fit::StopFlag::new(),
         ..brtf_workflow::FitSettings::new(word::<brtf_fit::ModelChoice>("model", model)?)
     };
     let inputs = FitInputs::classify(&paths).map_err(errors::workflow)?;
@@ -109,9 +109,10 @@ fn fit_set(
         }));
     }
     // Read and fitted on `jobs` threads, the GIL released; this thread
-    // watches for Ctrl-C meanwhile and stops the fit at the next incidence.
+    // watches for Ctrl-C meanwhile and stops the fit within one pass of
+    // the solve under way.
     let command_line = vec!["brtf.fit (Python)".to_string()];
-    let cancel = Cancel(AtomicBool::new(false));
+    let cancel = Cancel(settings.stop.clone());
     let fitted = std::thread::scope(|scope| {
         let worker = scope.spawn(|| -> Result<_, WorkflowError> {
             let job = FitJob::new(&inputs, &settings, name, command_line)?;
@@ -120,7 +121,7 @@ fn fit_set(
         while !worker.is_finished() {
             py.detach(|| std::thread::sleep(std::time::Duration::from_millis(20)));
             if let Err(interrupt) = py.check_signals() {
-                cancel.0.store(true, Ordering::Relaxed);
+                cancel.0.raise();
                 let _ = py.detach(|| worker.join());
                 return Err(interrupt);
             }
@@ -132,12 +133,13 @@ fn fit_set(
     Ok(fit::Fit::new(result, paths))
 }
 
-/// A fit's progress that only carries the stop request of Ctrl-C.
-struct Cancel(AtomicBool);
+/// A fit's progress that only carries the stop request of Ctrl-C (the
+/// same flag stops the solve under way).
+struct Cancel(brtf_fit::StopFlag);
 
 impl brtf_fit::Progress for Cancel {
     fn cancelled(&self) -> bool {
-        self.0.load(Ordering::Relaxed)
+        self.0.is_raised()
     }
 }
 

@@ -75,6 +75,8 @@ pub struct FitSettings {
     pub incidences: Option<IncidenceFilter>,
     /// Klems XML: view directions per outgoing patch.
     pub patch_samples: usize,
+    /// Raised to stop the fit (Python's Ctrl-C): see [`brtf_fit::StopFlag`].
+    pub stop: brtf_fit::StopFlag,
 }
 
 impl FitSettings {
@@ -108,6 +110,7 @@ impl FitSettings {
             sides: Sides::default(),
             incidences: None,
             patch_samples: brtf_fit::PatchAveraging::default().outgoing_samples,
+            stop: brtf_fit::StopFlag::default(),
         }
     }
 
@@ -185,6 +188,7 @@ impl FitSettings {
         config.floor = self.floor;
         config.loss = self.loss;
         config.multistart = self.multistart;
+        config.stop = self.stop.clone();
         let options = FitSetOptions {
             name,
             config,

@@ -306,3 +306,21 @@ fn the_converged_test_agrees_with_the_not_converged_warning() {
         }
     }
 }
+
+#[test]
+fn a_raised_stop_flag_ends_the_solve_at_its_next_pass() {
+    let truth = [0.45, 0.3, 0.2, 0.06, 0.09];
+    let data = synth(&material(MaterialKind::Plastic, &truth), 40.0, 3, 0.0, 1);
+    let mut config = FitConfig::new(MaterialKind::Plastic);
+    config.stop = crate::StopFlag::new();
+    let clone = config.clone();
+    assert!(fit_incidence(&data, &config).is_ok());
+    // Raised on a clone (as Python's Ctrl-C raises the caller's copy):
+    // no pass runs, so the fit has no solution.
+    clone.stop.raise();
+    assert!(config.stop.is_raised());
+    let stopped = fit_incidence(&data, &config);
+    assert!(stopped.is_err(), "{stopped:?}");
+    // The flag is no part of what decides a fit.
+    assert_eq!(config, FitConfig::new(MaterialKind::Plastic));
+}
