@@ -100,7 +100,62 @@ fn gonio(bytes: &[u8], name: &str, format: Option<SourceFormat>) -> Outcome {
     if let Some((class, detail)) = round_trip(&measurement, name) {
         return anomaly(class, detail);
     }
+    if let Some((class, detail)) = residuals_csv(measurement, name) {
+        return anomaly(class, detail);
+    }
     Outcome::Accepted
+}
+
+/// The committed fit of `data/alu-ggx`, whose recipe and first material
+/// turn an accepted measurement into `residuals.csv` rows.
+fn template_fit() -> &'static brtf_fit::FitResult {
+    static FIT: std::sync::OnceLock<brtf_fit::FitResult> = std::sync::OnceLock::new();
+    FIT.get_or_init(|| {
+        let text = include_str!("../../../fits/alu-ggx/fit.json");
+        brtf_fit::FitResult::from_json(text, Path::new("fits/alu-ggx/fit.json"))
+            .expect("the committed fit reads")
+    })
+}
+
+/// `residuals.csv` of an accepted measurement, as `brtf fit` writes it
+/// (prepared by a fit's recipe, the model beside each sample): one row per
+/// sample with the header's columns, every angle a finite number, every
+/// value one or empty (not available), every gate empty or a gate's name. A measurement the recipe refuses is no anomaly
+/// (the fit refuses it too, with its own message).
+fn residuals_csv(measurement: Measurement, name: &str) -> Option<(&'static str, String)> {
+    let fit = template_fit();
+    let samples = measurement.len();
+    let prepared = fit.recipe.prepare(measurement, name).ok()?;
+    let header = brtf_fit::residuals_header(prepared.channels());
+    let columns = header.trim_end().split(',').count();
+    let rows = brtf_fit::residual_rows(fit, 0, &prepared).concat();
+    let Ok(text) = String::from_utf8(rows) else {
+        return Some(("residuals.csv is not UTF-8", name.to_string()));
+    };
+    let gates: Vec<&str> = fit.recipe.selections.iter().map(|g| g.name()).collect();
+    let mut count = 0;
+    for line in text.lines() {
+        count += 1;
+        let fields: Vec<&str> = line.split(',').collect();
+        // Angles are numbers; a value that is not finite (a sample not
+        // available) is written as an empty field.
+        let number = |f: &&str| f.parse::<f64>().is_ok_and(f64::is_finite);
+        let numbers_read = fields.len() == columns
+            && fields[..4].iter().all(number)
+            && fields[4..columns - 1]
+                .iter()
+                .all(|f| f.is_empty() || number(f));
+        let gate = fields[fields.len() - 1];
+        if fields.len() != columns || !numbers_read || !(gate.is_empty() || gates.contains(&gate)) {
+            return Some(("residuals.csv row does not read back", line.to_string()));
+        }
+    }
+    (count != samples).then(|| {
+        (
+            "residuals.csv has other rows than samples",
+            format!("{count} rows for {samples} samples"),
+        )
+    })
 }
 
 /// The Klems reader, then what `brtf info` and the conversion to
