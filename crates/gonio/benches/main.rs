@@ -31,6 +31,11 @@ fn parse(c: &mut Criterion) {
     group.bench_function("golden_paper_from_path", |b| {
         b.iter(|| brtf_gonio::read_path(black_box(&path)).unwrap())
     });
+    // Lone-CR line ends (classic Mac): every row takes the general rules.
+    let lone_cr: Vec<u8> = bytes.iter().copied().filter(|&b| b != b'\n').collect();
+    group.bench_function("golden_paper_mountain_lone_cr", |b| {
+        b.iter(|| brtf_gonio::read_bytes(black_box(&lone_cr), &path).unwrap())
+    });
     group.finish();
 }
 

@@ -200,6 +200,7 @@ pub(crate) fn parse(text: &str, name: &Path) -> Result<Measurement, ReadError> {
             lines_before: first,
             first_data_line: first,
             channels,
+            line_feed: None,
         };
         rest.read_into(&mut samples, name)?;
     }
@@ -282,6 +283,11 @@ struct DataRows<'a> {
     lines_before: usize,
     first_data_line: usize,
     channels: Channels,
+    /// Where the general rules last found the next `\n` (see
+    /// [`Lines::line_feed`]): a file of lone-CR line ends has none, and
+    /// looking again for every row would read the rest of the file each
+    /// time (a CR-only 127 000-row scan took 15 s).
+    line_feed: Option<usize>,
 }
 
 impl DataRows<'_> {
@@ -298,10 +304,12 @@ impl DataRows<'_> {
             let (pos, rows) = plain_rows_of(self.channels, bytes, self.pos, samples);
             self.pos = pos;
             self.lines_before += rows;
-            let mut lines = Lines::resume(self.text, self.pos, self.lines_before);
+            let mut lines = Lines::resume(self.text, self.pos, self.lines_before)
+                .with_line_feed(self.line_feed);
             let Some((line_no, line)) = lines.next() else {
                 return Ok(());
             };
+            self.line_feed = lines.line_feed();
             self.pos = lines.position();
             self.lines_before = line_no;
             if line.trim_ascii().is_empty() {

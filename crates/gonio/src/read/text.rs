@@ -97,6 +97,20 @@ impl<'a> Lines<'a> {
     pub(crate) fn position(&self) -> usize {
         self.pos
     }
+
+    /// Where the next `\n` was found (at or after some earlier position;
+    /// the text's length when there is none), to hand to the next
+    /// iterator over the same text ([`Lines::with_line_feed`]).
+    pub(crate) fn line_feed(&self) -> Option<usize> {
+        self.next_line_feed
+    }
+
+    /// Takes a [`Lines::line_feed`] of an earlier iterator over the same
+    /// text; used only while it lies at or after the position.
+    pub(crate) fn with_line_feed(mut self, line_feed: Option<usize>) -> Self {
+        self.next_line_feed = line_feed;
+        self
+    }
 }
 
 impl<'a> Iterator for Lines<'a> {
