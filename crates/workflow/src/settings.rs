@@ -75,6 +75,8 @@ pub struct FitSettings {
     pub incidences: Option<IncidenceFilter>,
     /// Klems XML: view directions per outgoing patch.
     pub patch_samples: usize,
+    /// Tensor trees: the θ_in fitted (degrees); the Klems rings' when `None`.
+    pub theta_in_grid: Option<crate::ThetaGrid>,
 }
 
 impl FitSettings {
@@ -108,6 +110,7 @@ impl FitSettings {
             sides: Sides::default(),
             incidences: None,
             patch_samples: brtf_fit::PatchAveraging::default().outgoing_samples,
+            theta_in_grid: None,
         }
     }
 
@@ -214,6 +217,7 @@ impl FitSettings {
             klems: brtf_fit::KlemsOptions {
                 side: None,
                 incidences: self.incidences.clone(),
+                theta_in_grid: self.theta_in_grid.as_ref().map(|g| g.0.clone()),
             },
             auto,
         };

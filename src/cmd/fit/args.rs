@@ -133,6 +133,9 @@ pub(crate) struct FitArgs {
     /// model is averaged.
     #[arg(long, default_value_t = brtf_fit::PatchAveraging::default().outgoing_samples)]
     pub patch_samples: usize,
+    /// Tensor trees: the θ_in fitted, e.g. `0,15,30,45,60,75` [default: 0,10,…,70,82.5].
+    #[arg(long, value_parser = |s: &str| s.parse::<brtf_workflow::ThetaGrid>())]
+    pub theta_in_grid: Option<brtf_workflow::ThetaGrid>,
 }
 
 impl FitArgs {
@@ -168,6 +171,7 @@ impl FitArgs {
             sides: self.side,
             incidences: self.incidences.clone(),
             patch_samples: self.patch_samples,
+            theta_in_grid: self.theta_in_grid.clone(),
             ..FitSettings::new(model)
         })
     }

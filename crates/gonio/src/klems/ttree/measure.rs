@@ -76,7 +76,7 @@ impl TensorTree {
         let w = finest(self);
         let p = self.input_point(theta_deg, phi_deg);
         let centre = |x: f64| ((x / w).floor() + 0.5) * w;
-        match self.rank {
+        let (theta, phi) = match self.rank {
             TreeRank::Isotropic => {
                 let s = (1.0 - 2.0 * centre(p[0])).clamp(0.0, 1.0);
                 (s.asin().to_degrees(), phi_deg)
@@ -85,7 +85,54 @@ impl TensorTree {
                 let d = square_to_disk(centre(p[0]), centre(p[1]));
                 disk_to_angles([-d[0], -d[1]])
             }
-        }
+        };
+        // To 1e-4°: readable, still inside the cell, and the same again
+        // when a fit's incidence is placed a second time.
+        let round = |a: f64| (a * 1e4).round() / 1e4;
+        (round(theta), round(phi))
+    }
+
+    /// `n` light directions (towards the source, light on +z) stratified
+    /// over the finest input cell holding incidence (θ, φ): over its
+    /// x₀ range at azimuth φ for `TensorTree3`, over its square cell for
+    /// `TensorTree4`. Leaves that `bsdf2ttree` super-sampled average over
+    /// this cell.
+    pub fn input_cell_lights(
+        &self,
+        theta_deg: f64,
+        phi_deg: f64,
+        n: usize,
+        rng: &mut brtf_model::Rng,
+    ) -> Vec<DVec3> {
+        let w = finest(self);
+        let p = self.input_point(theta_deg, phi_deg);
+        let corner = |x: f64| (x / w).floor() * w;
+        let (x0, y0) = (corner(p[0]), corner(p[1]));
+        let n = n.max(1);
+        (0..n)
+            .map(|k| {
+                let [ju, jv] = rng.uniform2();
+                match self.rank {
+                    TreeRank::Isotropic => {
+                        let x = x0 + w * (k as f64 + ju) / n as f64;
+                        let s = (1.0 - 2.0 * x).clamp(0.0, 1.0);
+                        let (sp, cp) = phi_deg.to_radians().sin_cos();
+                        DVec3::new(s * cp, s * sp, (1.0 - s * s).sqrt())
+                    }
+                    TreeRank::Anisotropic => {
+                        // Strata of a 2 × n/2 grid (n odd: one row).
+                        let rows = if n.is_multiple_of(2) { 2 } else { 1 };
+                        let columns = n / rows;
+                        let (r, c) = (k / columns, k % columns);
+                        let u = x0 + w * (r as f64 + ju) / rows as f64;
+                        let v = y0 + w * (c as f64 + jv) / columns as f64;
+                        let d = square_to_disk(u, v);
+                        let z = (1.0 - d[0] * d[0] - d[1] * d[1]).max(0.0).sqrt();
+                        DVec3::new(-d[0], -d[1], z)
+                    }
+                }
+            })
+            .collect()
     }
 
     /// Incidence (θ, φ) lit from `side` as one [`Measurement`] in that
