@@ -45,4 +45,5 @@ mod rtrace;
 mod safety;
 mod shadow;
 mod speed;
+mod ttree;
 mod verdict;

@@ -26,6 +26,14 @@ pub struct TreeSample {
     pub turn_deg: f64,
     /// On the transmission side (z < 0).
     pub transmitted: bool,
+    /// The leaf's lower corner in the input dimensions (x₀ only for
+    /// `TensorTree3`).
+    pub input_min: [f64; 2],
+    /// The tree's rank.
+    pub rank: TreeRank,
+    /// The source's azimuth, degrees (the isotropic tree's light lies in
+    /// this plane).
+    pub phi_in_deg: f64,
 }
 
 impl TreeSample {
@@ -36,6 +44,52 @@ impl TreeSample {
         let (dx, dy) = (c * d[0] - s * d[1], s * d[0] + c * d[1]);
         let z = (1.0 - dx * dx - dy * dy).max(0.0).sqrt();
         DVec3::new(dx, dy, if self.transmitted { -z } else { z })
+    }
+
+    /// The light direction (towards the source, on +z) of input point
+    /// (u, v) of the leaf (each in [0, 1]; v unused for `TensorTree3`).
+    pub fn light_at(&self, u: f64, v: f64) -> DVec3 {
+        match self.rank {
+            TreeRank::Isotropic => {
+                let x = self.input_min[0] + u * self.size;
+                let s = (1.0 - 2.0 * x).clamp(0.0, 1.0);
+                let (sp, cp) = self.phi_in_deg.to_radians().sin_cos();
+                DVec3::new(s * cp, s * sp, (1.0 - s * s).sqrt())
+            }
+            TreeRank::Anisotropic => {
+                let d = square_to_disk(
+                    self.input_min[0] + u * self.size,
+                    self.input_min[1] + v * self.size,
+                );
+                let z = (1.0 - d[0] * d[0] - d[1] * d[1]).max(0.0).sqrt();
+                DVec3::new(-d[0], -d[1], z)
+            }
+        }
+    }
+
+    /// `n` (light, view) pairs spread over the leaf's whole hypercube: the
+    /// views stratified over its outgoing cell
+    /// ([`stratified_directions`](Self::stratified_directions)), the
+    /// lights stratified in the first input coordinate (shuffled against
+    /// the views) and jittered in the second. `rttree_reduce` merges
+    /// finer leaves by averaging them, inputs included, so their mean
+    /// estimates the leaf's value.
+    pub fn stratified_pairs(&self, n: usize, rng: &mut brtf_model::Rng) -> Vec<(DVec3, DVec3)> {
+        let views = self.stratified_directions(n, rng);
+        let n = views.len();
+        let mut order: Vec<usize> = (0..n).collect();
+        for k in (1..n).rev() {
+            let j = ((rng.uniform() * (k + 1) as f64) as usize).min(k);
+            order.swap(k, j);
+        }
+        views
+            .into_iter()
+            .zip(order)
+            .map(|(view, stratum)| {
+                let [ju, jv] = rng.uniform2();
+                (self.light_at((stratum as f64 + ju) / n as f64, jv), view)
+            })
+            .collect()
     }
 
     /// `n` directions stratified over the cell, one per stratum of an
@@ -92,49 +146,6 @@ impl TensorTree {
         (round(theta), round(phi))
     }
 
-    /// `n` light directions (towards the source, light on +z) stratified
-    /// over the finest input cell holding incidence (θ, φ): over its
-    /// x₀ range at azimuth φ for `TensorTree3`, over its square cell for
-    /// `TensorTree4`. Leaves that `bsdf2ttree` super-sampled average over
-    /// this cell.
-    pub fn input_cell_lights(
-        &self,
-        theta_deg: f64,
-        phi_deg: f64,
-        n: usize,
-        rng: &mut brtf_model::Rng,
-    ) -> Vec<DVec3> {
-        let w = finest(self);
-        let p = self.input_point(theta_deg, phi_deg);
-        let corner = |x: f64| (x / w).floor() * w;
-        let (x0, y0) = (corner(p[0]), corner(p[1]));
-        let n = n.max(1);
-        (0..n)
-            .map(|k| {
-                let [ju, jv] = rng.uniform2();
-                match self.rank {
-                    TreeRank::Isotropic => {
-                        let x = x0 + w * (k as f64 + ju) / n as f64;
-                        let s = (1.0 - 2.0 * x).clamp(0.0, 1.0);
-                        let (sp, cp) = phi_deg.to_radians().sin_cos();
-                        DVec3::new(s * cp, s * sp, (1.0 - s * s).sqrt())
-                    }
-                    TreeRank::Anisotropic => {
-                        // Strata of a 2 × n/2 grid (n odd: one row).
-                        let rows = if n.is_multiple_of(2) { 2 } else { 1 };
-                        let columns = n / rows;
-                        let (r, c) = (k / columns, k % columns);
-                        let u = x0 + w * (r as f64 + ju) / rows as f64;
-                        let v = y0 + w * (c as f64 + jv) / columns as f64;
-                        let d = square_to_disk(u, v);
-                        let z = (1.0 - d[0] * d[0] - d[1] * d[1]).max(0.0).sqrt();
-                        DVec3::new(-d[0], -d[1], z)
-                    }
-                }
-            })
-            .collect()
-    }
-
     /// Incidence (θ, φ) lit from `side` as one [`Measurement`] in that
     /// side's frame (light on +z; reflection samples on +z, transmission
     /// on −z), at the centre of its finest input cell
@@ -169,6 +180,9 @@ impl TensorTree {
                     size: cell.size,
                     turn_deg,
                     transmitted,
+                    input_min: cell.input_min,
+                    rank: self.rank,
+                    phi_in_deg: phi,
                 };
                 let v = place.direction_at(0.5, 0.5);
                 let cos = v.z.abs().max(1e-6);

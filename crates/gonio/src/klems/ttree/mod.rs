@@ -99,6 +99,8 @@ pub struct OutCell {
     pub size: f64,
     /// BSDF, 1/sr.
     pub value: f64,
+    /// The leaf's lower corner in the input dimensions.
+    pub input_min: [f64; 2],
 }
 
 impl OutCell {
@@ -121,6 +123,7 @@ impl TreeBlock {
                 y: c.min[inputs + 1],
                 size: c.size,
                 value: c.value,
+                input_min: [c.min[0], if inputs == 2 { c.min[1] } else { 0.0 }],
             })
             .collect()
     }
