@@ -15,9 +15,10 @@ use std::path::PathBuf;
 #[derive(Args, Debug)]
 pub(crate) struct FitArgs {
     /// Measurement files, one incidence each (.mpc or pab-opto Mountain); or
-    /// Klems BSDF XML files (each incident patch of a side an incidence,
-    /// docs/klems.md); or sample folders, one sample each (its .mpc and
-    /// .txt files), each fitted into OUT/<name>/.
+    /// Klems BSDF XML files (each incident patch of a side an incidence;
+    /// tensor trees: each --theta-in-grid angle, docs/klems.md); or sample
+    /// folders, one sample each (its .mpc and .txt files), each fitted into
+    /// OUT/<name>/.
     #[arg(required_unless_present = "en14501")]
     pub files: Vec<PathBuf>,
     /// Model to fit; `auto` fits plastic or metal, its anisotropic type,
