@@ -223,3 +223,82 @@ fn fits_recover_materials_from_bsdf2ttree_trees() {
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+/// Without Radiance: the committed `bsdf2ttree` fixture is summarised and
+/// fitted, and `--theta-in-grid` is refused where it means nothing.
+#[test]
+fn fixture_tree_is_summarised_and_fitted_and_the_grid_option_is_checked() {
+    let tree = crate::common::repo_path("crates/gonio/tests/fixtures/ttree/asym-t3-g4.xml");
+    let info = brtf(&["info", s(&tree)], "").ok();
+    assert!(
+        info.contains("format        TensorTree3 (isotropic tensor tree)"),
+        "{info}"
+    );
+    assert!(
+        info.contains("Reflection Back     Radiance rf, light from +z"),
+        "{info}"
+    );
+    let tmp = temp_dir();
+    let out = tmp.path().join("fit");
+    let run = brtf(
+        &[
+            "fit",
+            s(&tree),
+            "--model",
+            "plastic",
+            "--gray",
+            "--out",
+            s(&out),
+            "--no-plots",
+            "--no-export",
+            "--no-adequacy",
+            "--theta-in-grid",
+            "20,21,40",
+        ],
+        "",
+    )
+    .ok();
+    // 20° and 21° share one input cell of the -g 4 tree: two incidences.
+    assert_eq!(table(&out).len(), 2, "{run}");
+
+    let mpc = crate::common::repo_path("crates/gonio/tests/fixtures/pab-aluA-st1:+30+0.mpc");
+    let klems = crate::common::repo_path("../shared/data/lbnl-frads-klems-fabrics/2011-SA1.xml");
+    for (file, expected) in [
+        (
+            &mpc,
+            "--theta-in-grid sets the incidences of tensor-tree BSDF XML files",
+        ),
+        (
+            &klems,
+            "--theta-in-grid sets the incidences of tensor trees",
+        ),
+    ] {
+        let out = tmp.path().join("refused");
+        let run = brtf(
+            &[
+                "fit",
+                s(file),
+                "--model",
+                "plastic",
+                "--out",
+                s(&out),
+                "--theta-in-grid",
+                "10",
+            ],
+            "",
+        );
+        assert!(!run.success && run.stderr.contains(expected), "{run}");
+    }
+    let run = brtf(
+        &[
+            "fit",
+            s(&tree),
+            "--model",
+            "plastic",
+            "--theta-in-grid",
+            "10,95",
+        ],
+        "",
+    );
+    assert!(!run.success && run.stderr.contains("`95`"), "{run}");
+}

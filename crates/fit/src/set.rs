@@ -129,6 +129,13 @@ pub enum FitSetError {
     /// The fitted model reflects nothing at the `--rho` incidence.
     #[error("--rho: the fitted model has no reflectance at {0}°")]
     NoReflectance(f64),
+    /// `--theta-in-grid` given for a Klems matrix file, whose incidences
+    /// are its incident patches.
+    #[error(
+        "{}: --theta-in-grid sets the incidences of tensor trees; a Klems matrix file's are its incident patches (select them with --incidences)",
+        .0.display()
+    )]
+    ThetaGridOnKlemsMatrix(PathBuf),
     /// The selection left no incidence to fit.
     #[error(
         "no incidence to fit: the Klems file has no data for this side, or --incidences excludes every patch"
@@ -394,6 +401,9 @@ fn read_input(
     let Some(measurement) = measurement else {
         let side = klems.side.unwrap_or(brtf_gonio::klems::Side::Front);
         let bsdf = match brtf_gonio::klems::read_any_bytes(&bytes, path)? {
+            brtf_gonio::klems::BsdfXml::Klems(_) if klems.theta_in_grid.is_some() => {
+                return Err(FitSetError::ThetaGridOnKlemsMatrix(path.to_path_buf()));
+            }
             brtf_gonio::klems::BsdfXml::Klems(bsdf) => bsdf,
             brtf_gonio::klems::BsdfXml::TensorTree(tree) => {
                 let thetas = klems

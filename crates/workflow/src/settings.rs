@@ -127,6 +127,11 @@ impl FitSettings {
                 "--incidences selects the incident patches of Klems BSDF XML files".into(),
             ));
         }
+        if !klems && self.theta_in_grid.is_some() {
+            return Err(WorkflowError::Usage(
+                "--theta-in-grid sets the incidences of tensor-tree BSDF XML files".into(),
+            ));
+        }
         if klems && self.phi_offset.is_some() {
             return Err(WorkflowError::Usage(
                 "--phi-offset turns gonio scans; Klems patches keep their basis".into(),
