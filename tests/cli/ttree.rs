@@ -302,3 +302,44 @@ fn fixture_tree_is_summarised_and_fitted_and_the_grid_option_is_checked() {
     );
     assert!(!run.success && run.stderr.contains("`95`"), "{run}");
 }
+
+/// A two-sided tree (the fixture's blocks copied to the `Front`
+/// directions, light from −z) fits each side into its own folder, with
+/// the same result on both, and the side-by-side report.
+#[test]
+fn a_two_sided_tree_fits_both_sides() {
+    let fixture = crate::common::repo_path("crates/gonio/tests/fixtures/ttree/asym-t3-g4.xml");
+    let text = std::fs::read_to_string(fixture).unwrap();
+    let start = text.find("<WavelengthData>").unwrap();
+    let end = text.rfind("</WavelengthData>").unwrap() + "</WavelengthData>".len();
+    let back = text[start..end]
+        .replace("Reflection Back", "Reflection Front")
+        .replace("Transmission Back", "Transmission Front");
+    let tmp = temp_dir();
+    let both = tmp.path().join("both.xml");
+    std::fs::write(&both, format!("{}\n{back}{}", &text[..end], &text[end..])).unwrap();
+    let out = tmp.path().join("fit");
+    brtf(
+        &[
+            "fit",
+            s(&both),
+            "--model",
+            "plastic",
+            "--gray",
+            "--out",
+            s(&out),
+            "--no-plots",
+            "--no-export",
+            "--no-adequacy",
+            "--theta-in-grid",
+            "20,50",
+        ],
+        "",
+    )
+    .ok();
+    let front = table(&out.join("front"));
+    let back = table(&out.join("back"));
+    assert_eq!(front.len(), 2);
+    assert_eq!(front, back);
+    assert!(out.join("report.html").is_file());
+}
