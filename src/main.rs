@@ -28,7 +28,7 @@ enum Command {
     Eval(cmd::eval::EvalArgs),
     /// Directional-hemispherical reflectance and transmittance of a material.
     Albedo(cmd::albedo::AlbedoArgs),
-    /// Summarise measurement files (.mpc, pab-opto Mountain or Klems BSDF XML).
+    /// Summarise measurement files (.mpc, pab-opto Mountain, Klems or tensor-tree BSDF XML).
     Info(cmd::info::InfoArgs),
     /// Write synthetic measurement files with realistic instrument effects.
     Synth(cmd::synth::SynthArgs),

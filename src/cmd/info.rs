@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub(crate) struct InfoArgs {
-    /// Measurement files (.mpc, pab-opto Mountain or Klems BSDF XML).
+    /// Measurement files (.mpc, pab-opto Mountain, Klems or tensor-tree BSDF XML).
     #[arg(required = true)]
     pub(crate) files: Vec<PathBuf>,
     /// Print machine-readable JSON instead of text.

@@ -517,7 +517,7 @@ fn a_one_sided_file_fits_its_side_and_is_named_after_the_file() {
     let stderr = run.stderr.clone();
     run.ok();
     assert!(
-        stderr.contains("note: the Klems file holds the front side only"),
+        stderr.contains("note: the BSDF XML file holds the front side only"),
         "{stderr}"
     );
     let fit: serde_json::Value =

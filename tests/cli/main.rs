@@ -46,5 +46,6 @@ mod rtrace;
 mod safety;
 mod shadow;
 mod speed;
+mod ttree;
 mod verdict;
 mod view3d;

@@ -57,6 +57,7 @@ mod summary;
 mod table;
 #[cfg(test)]
 mod tests;
+pub mod ttree;
 mod uncertainty;
 mod validate;
 mod verdict;

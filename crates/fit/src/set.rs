@@ -90,6 +90,10 @@ pub struct KlemsOptions {
     pub side: Option<brtf_gonio::klems::Side>,
     /// Which incident patches (by θ_in); all when `None`.
     pub incidences: Option<crate::klems::IncidenceFilter>,
+    /// Tensor trees: the θ_in fitted (degrees, at φ_in = 0), each moved
+    /// to the centre of the tree's finest input cell;
+    /// [`crate::ttree::DEFAULT_THETAS`] when `None`.
+    pub theta_in_grid: Option<Vec<f64>>,
 }
 
 /// Why a fit set could not be made.
@@ -125,6 +129,13 @@ pub enum FitSetError {
     /// The fitted model reflects nothing at the `--rho` incidence.
     #[error("--rho: the fitted model has no reflectance at {0}°")]
     NoReflectance(f64),
+    /// `--theta-in-grid` given for a Klems matrix file, whose incidences
+    /// are its incident patches.
+    #[error(
+        "{}: --theta-in-grid sets the incidences of tensor trees; a Klems matrix file's are its incident patches (select them with --incidences)",
+        .0.display()
+    )]
+    ThetaGridOnKlemsMatrix(PathBuf),
     /// The selection left no incidence to fit.
     #[error(
         "no incidence to fit: the Klems file has no data for this side, or --incidences excludes every patch"
@@ -388,8 +399,44 @@ fn read_input(
         }
     };
     let Some(measurement) = measurement else {
-        let bsdf = brtf_gonio::klems::read_bytes(&bytes, path)?;
         let side = klems.side.unwrap_or(brtf_gonio::klems::Side::Front);
+        let bsdf = match brtf_gonio::klems::read_any_bytes(&bytes, path)? {
+            brtf_gonio::klems::BsdfXml::Klems(_) if klems.theta_in_grid.is_some() => {
+                return Err(FitSetError::ThetaGridOnKlemsMatrix(path.to_path_buf()));
+            }
+            brtf_gonio::klems::BsdfXml::Klems(bsdf) => bsdf,
+            brtf_gonio::klems::BsdfXml::TensorTree(tree) => {
+                let thetas = klems
+                    .theta_in_grid
+                    .clone()
+                    .unwrap_or_else(|| crate::ttree::DEFAULT_THETAS.to_vec());
+                let mut inputs: Vec<Input> = Vec::new();
+                for (patch, &theta) in thetas.iter().enumerate() {
+                    if klems.incidences.as_ref().is_some_and(|f| !f.keeps(theta)) {
+                        continue;
+                    }
+                    let at = crate::klems::KlemsPatchRef { side, patch };
+                    let label = format!("{source} [{side} patch {patch}]");
+                    let Some(mut prepared) =
+                        crate::ttree::prepare_incidence(recipe, &tree, side, theta, 0.0, &label)?
+                    else {
+                        continue;
+                    };
+                    // Two θ_in in one input cell are one incidence.
+                    let snapped = prepared.measurement.incidence.theta_deg;
+                    if inputs
+                        .iter()
+                        .any(|i| (i.file.theta_in - snapped).abs() < 1e-9)
+                    {
+                        continue;
+                    }
+                    prepared.source = label;
+                    let samples = prepared.measurement.len();
+                    inputs.push(input(prepared, samples, Some(at)));
+                }
+                return Ok(inputs);
+            }
+        };
         let mut inputs = Vec::new();
         for patch in 0..bsdf.basis.len() {
             let at = crate::klems::KlemsPatchRef { side, patch };
@@ -425,9 +472,20 @@ pub fn prepare_input(
     let label = input.label();
     match input.klems {
         Some(at) => {
-            let bsdf = brtf_gonio::klems::read_bytes(bytes, path)?;
-            let mut prepared = crate::klems::prepare_patch(recipe, &bsdf, at, &label)?
-                .ok_or(FitSetError::NoIncidences)?;
+            let prepared = match brtf_gonio::klems::read_any_bytes(bytes, path)? {
+                brtf_gonio::klems::BsdfXml::Klems(bsdf) => {
+                    crate::klems::prepare_patch(recipe, &bsdf, at, &label)?
+                }
+                brtf_gonio::klems::BsdfXml::TensorTree(tree) => crate::ttree::prepare_incidence(
+                    recipe,
+                    &tree,
+                    at.side,
+                    input.theta_in,
+                    input.phi_in,
+                    &label,
+                )?,
+            };
+            let mut prepared = prepared.ok_or(FitSetError::NoIncidences)?;
             prepared.source = label;
             Ok(prepared)
         }

@@ -10,7 +10,7 @@ use brtf_fuzz::run::thread_cpu_time;
 use brtf_fuzz::{Config, SeedSources, Seeds, Target, format_report, make_case, run, run_case};
 use clap::Parser;
 
-/// Mutation fuzzing of the .mpc, Mountain, .rad, fit.json and Klems XML parsers.
+/// Mutation fuzzing of the .mpc, Mountain, .rad, fit.json, Klems XML and tensor-tree parsers.
 #[derive(Parser, Debug)]
 #[command(version)]
 struct Args {
@@ -65,6 +65,8 @@ enum TargetArg {
     FitJson,
     /// Klems BSDF XML, and brtf's Klems writer.
     Klems,
+    /// Tensor-tree BSDF XML.
+    TensorTree,
 }
 
 impl TargetArg {
@@ -76,6 +78,7 @@ impl TargetArg {
             TargetArg::Rad => Target::Rad,
             TargetArg::FitJson => Target::FitJson,
             TargetArg::Klems => Target::Klems,
+            TargetArg::TensorTree => Target::TensorTree,
         }
     }
 }

@@ -82,7 +82,7 @@ fn target_weight(target: Target) -> usize {
     match target {
         Target::Mpc => 3,
         Target::Mountain | Target::Rad | Target::FitJson => 2,
-        Target::DetectedGonio | Target::Klems => 1,
+        Target::DetectedGonio | Target::Klems | Target::TensorTree => 1,
     }
 }
 

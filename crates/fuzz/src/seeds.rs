@@ -25,17 +25,21 @@ pub enum Target {
     /// `brtf_gonio::klems::read_bytes`, then `brtf info`, the conversion to
     /// measurements and brtf's Klems writer and back.
     Klems,
+    /// `brtf_gonio::klems::read_any_bytes` on tensor trees, then `brtf
+    /// info` and the per-incidence measurements a fit takes.
+    TensorTree,
 }
 
 impl Target {
     /// Every target, in report order.
-    pub const ALL: [Target; 6] = [
+    pub const ALL: [Target; 7] = [
         Target::Mpc,
         Target::Mountain,
         Target::DetectedGonio,
         Target::Rad,
         Target::FitJson,
         Target::Klems,
+        Target::TensorTree,
     ];
 
     /// A short name for reports.
@@ -47,6 +51,7 @@ impl Target {
             Target::Rad => "rad",
             Target::FitJson => "fit.json",
             Target::Klems => "klems xml",
+            Target::TensorTree => "tensor tree",
         }
     }
 }
@@ -179,6 +184,17 @@ impl Seeds {
                 whole_big_file: true,
             });
         }
+        // Tensor trees written by Radiance's bsdf2ttree (the gonio tests'
+        // fixtures, about 20 kB each).
+        for path in files_with_extension(&repo.join("crates/gonio/tests/fixtures/ttree"), "xml")? {
+            seeds.all.push(Seed {
+                target: Target::TensorTree,
+                name: file_name(&path),
+                origin: format!("crates/gonio/tests/fixtures/ttree/{}", file_name(&path)),
+                bytes: read(&path)?,
+                whole_big_file: false,
+            });
+        }
         for path in rad_files(repo) {
             let Ok(bytes) = std::fs::read(&path) else {
                 continue; // vanished since the walk
@@ -206,6 +222,7 @@ impl Seeds {
             Target::Rad,
             Target::FitJson,
             Target::Klems,
+            Target::TensorTree,
         ] {
             if !seeds.all.iter().any(|s| s.target == target) {
                 return Err(format!("no seed file for {}", target.label()));

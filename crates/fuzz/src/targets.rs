@@ -47,7 +47,62 @@ pub fn exercise(target: Target, name: &str, bytes: &[u8]) -> Outcome {
         Target::Rad => rad(bytes, name),
         Target::FitJson => fit_json(bytes, name),
         Target::Klems => klems(bytes, name, true),
+        Target::TensorTree => tensor_tree(bytes, name),
     }
+}
+
+/// The BSDF XML reader on tensor trees, then `brtf info`'s totals and the
+/// measurements and leaf directions a fit takes at `brtf info`'s θ_in.
+fn tensor_tree(bytes: &[u8], name: &str) -> Outcome {
+    use brtf_gonio::klems::{BsdfXml, ttree::INFO_THETAS};
+    let tree = match brtf_gonio::klems::read_any_bytes(bytes, name) {
+        Ok(BsdfXml::TensorTree(tree)) => tree,
+        Ok(BsdfXml::Klems(_)) => return Outcome::Accepted,
+        Err(e) => {
+            let message = e.to_string();
+            let lines = line_count(bytes, true);
+            return match e.line() {
+                Some(line) if line == 0 || line > lines => anomaly(
+                    "error line outside the file",
+                    format!("error on line {line} of a {lines}-line file: {message}"),
+                ),
+                _ => located(message, name),
+            };
+        }
+    };
+    let info = tree.info();
+    let _ = info.to_string();
+    let not_finite = |v: Option<f64>| v.is_some_and(|v| !v.is_finite());
+    if let Some(p) = info
+        .incidences
+        .iter()
+        .find(|p| not_finite(p.rho_dh) || not_finite(p.tau_dh))
+    {
+        return anomaly(
+            "accepted tensor tree has a non-finite total",
+            format!("{p:?}"),
+        );
+    }
+    for side in tree.sides_present() {
+        for theta in INFO_THETAS {
+            let Some((m, places)) = tree.measurement(side, theta, 0.0) else {
+                continue;
+            };
+            let _ = m.summary();
+            let mut rng = brtf_model::Rng::new(1, 0);
+            for place in places.iter().take(50) {
+                for (light, view) in place.stratified_pairs(4, &mut rng) {
+                    if !(light.is_finite() && view.is_finite()) {
+                        return anomaly(
+                            "tensor-tree leaf direction is not finite",
+                            format!("{place:?}"),
+                        );
+                    }
+                }
+            }
+        }
+    }
+    Outcome::Accepted
 }
 
 /// An accepted Klems file written by brtf's writer reads back with the

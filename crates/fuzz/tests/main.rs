@@ -1,6 +1,7 @@
 //! The CI version of the fuzz run (`scripts/fuzz.sh` is the long one):
 //! 20 000 mutated inputs through the measurement and `.rad` parsers, and
-//! 20 000 through the `fit.json` reader; no panic, no hang.
+//! 20 000 each through the `fit.json`, Klems and tensor-tree readers; no
+//! panic, no hang.
 //!
 //! Whole big files are left to `scripts/fuzz.sh`: a 127 000-row read and
 //! summary on a busy 2-core CI machine could pass 1 s without any bug; the
@@ -69,6 +70,23 @@ fn klems_reader_survives_20000_mutated_inputs() {
     assert!(report.hangs.is_empty(), "{text}");
     assert!(report.anomalies.is_empty(), "{text}");
     let stats = &report.per_target[&Target::Klems];
+    assert!(stats.accepted > 0 && stats.rejected > 0, "{text}");
+}
+
+/// The tensor-tree reader: no panic, no hang, every error inside the
+/// file, and the leaves of what it accepts give finite totals and
+/// directions.
+#[test]
+fn tensor_tree_reader_survives_20000_mutated_inputs() {
+    let config = config(&[Target::TensorTree]);
+    let report = run(&seeds(), &config);
+    let text = format_report(&report, &config);
+    println!("{text}");
+    assert_eq!(report.cases, 20_000);
+    assert!(report.panics.is_empty(), "{text}");
+    assert!(report.hangs.is_empty(), "{text}");
+    assert!(report.anomalies.is_empty(), "{text}");
+    let stats = &report.per_target[&Target::TensorTree];
     assert!(stats.accepted > 0 && stats.rejected > 0, "{text}");
 }
 

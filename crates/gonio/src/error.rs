@@ -219,9 +219,21 @@ pub enum KlemsProblem {
     /// A required child element is missing.
     #[error("missing <{0}>")]
     Missing(&'static str),
-    /// The data are a tensor tree, not a Klems matrix.
-    #[error("not supported yet: tensor tree (`{0}`); only Klems matrices (Columns or Rows) are")]
+    /// The data are a tensor tree, not a Klems matrix, and the caller
+    /// asked for a matrix (`klems::read_any_path` reads both).
+    #[error("a tensor tree (`{0}`), not a Klems matrix (Columns or Rows)")]
     TensorTree(String),
+    /// A tensor tree block whose `AngleBasis` is not `LBNL/Shirley-Chiu`.
+    #[error("unsupported angle basis `{0}` for a tensor tree (expected LBNL/Shirley-Chiu)")]
+    TreeBasis(String),
+    /// A tensor tree's `ScatteringData` that cannot be read.
+    #[error("{what}: {problem}")]
+    Tree {
+        /// Band and direction, e.g. `Visible Reflection Back`.
+        what: String,
+        /// What is wrong.
+        problem: TreeProblem,
+    },
     /// `IncidentDataStructure` is neither `Columns` nor `Rows`.
     #[error("unknown data structure `{0}` (expected Columns or Rows)")]
     UnknownStructure(String),
@@ -309,6 +321,33 @@ pub enum KlemsProblem {
          read it with brtf_gonio::klems (brtf info reads it)"
     )]
     ManyIncidences,
+}
+
+/// What is wrong with a tensor tree's nested `{ … }` text (see
+/// [`KlemsProblem::Tree`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum TreeProblem {
+    /// A brace is missing or misplaced, or text follows the tree.
+    #[error("{0}")]
+    Syntax(&'static str),
+    /// A grid whose number of values is not 2^(rank·k).
+    #[error("a grid of {found} values (a grid holds 1, 2^{rank}, 4^{rank}, ... values)")]
+    ValueCount {
+        /// Values found.
+        found: usize,
+        /// 3 or 4.
+        rank: usize,
+    },
+    /// A value that is not a finite number.
+    #[error("`{0}` is not a finite number")]
+    NotANumber(String),
+    /// A value below −1e-3.
+    #[error("value {0} is negative (below -1e-3)")]
+    Negative(f64),
+    /// More halvings than the reader accepts.
+    #[error("the tree is more than {0} levels deep")]
+    TooDeep(u32),
 }
 
 /// Writing a measurement failed.

@@ -57,7 +57,7 @@ mod write;
 
 pub use aperture::{Apertures, DETECTOR_APERTURE_KEY, SOURCE_APERTURE_KEY};
 pub use convert::{Converted, GRAZING_COS_LIMIT};
-pub use error::{ConvertError, KlemsProblem, ParseErrorKind, ReadError, WriteError};
+pub use error::{ConvertError, KlemsProblem, ParseErrorKind, ReadError, TreeProblem, WriteError};
 pub use integral::{HemisphereIntegral, hemispherical_integral};
 pub use measurement::{
     BeamReference, Channels, Hemisphere, Hemispheres, Incidence, IncidenceOrigin, Measurement,

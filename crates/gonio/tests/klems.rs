@@ -488,12 +488,12 @@ fn mismatched_bases_are_refused() {
 }
 
 #[test]
-fn tensor_trees_are_not_supported_yet() {
+fn the_matrix_reader_refuses_a_tensor_tree() {
     let text = quarter_file("TensorTree3", "", &[]);
     let (message, line, problem) = klems_error(&text, "tree.xml");
     assert_eq!(problem, KlemsProblem::TensorTree("TensorTree3".into()));
     assert!(
-        message.contains("not supported yet: tensor tree"),
+        message.contains("a tensor tree (`TensorTree3`), not a Klems matrix"),
         "{message}"
     );
     assert_eq!(line, 6);

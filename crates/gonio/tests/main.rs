@@ -19,5 +19,6 @@ mod solid_angle;
 mod solid_angle_paths;
 mod summary;
 mod synth;
+mod ttree;
 mod voronoi_fast_path;
 mod write;

@@ -69,3 +69,28 @@ pub fn parse_numbers<const N: usize>(text: &str) -> Result<[f64; N], String> {
         .and_then(|v| v.try_into().ok())
         .ok_or_else(|| format!("{text}: give {N} comma-separated numbers"))
 }
+
+/// The θ_in at which a tensor tree is fitted (`--theta-in-grid`):
+/// comma-separated degrees, each in [0, 90).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ThetaGrid(pub Vec<f64>);
+
+impl std::str::FromStr for ThetaGrid {
+    type Err = String;
+
+    fn from_str(text: &str) -> Result<ThetaGrid, String> {
+        let mut thetas = Vec::new();
+        for part in text.split(',').map(str::trim) {
+            match part.parse::<f64>() {
+                Ok(t) if (0.0..90.0).contains(&t) => thetas.push(t),
+                _ => {
+                    return Err(format!(
+                        "`{}`: give comma-separated angles from 0 to below 90 degrees",
+                        short(part)
+                    ));
+                }
+            }
+        }
+        Ok(ThetaGrid(thetas))
+    }
+}

@@ -1,7 +1,8 @@
-//! `brtf info`: a summary of each measurement or Klems BSDF XML file, as
-//! text or as one JSON array.
+//! `brtf info`: a summary of each measurement or BSDF XML file (Klems
+//! matrices or a tensor tree), as text or as one JSON array.
 
 use crate::WorkflowError;
+use brtf_gonio::klems::BsdfXml;
 use serde::Serialize;
 use std::io::Write;
 use std::path::PathBuf;
@@ -19,6 +20,7 @@ struct FileSummary<S> {
 enum Entry {
     Measurement(FileSummary<brtf_gonio::Summary>),
     Klems(FileSummary<brtf_gonio::klems::KlemsInfo>),
+    Tree(FileSummary<brtf_gonio::klems::TreeInfo>),
 }
 
 /// Writes the summary of every file to `out`: a block of text per file,
@@ -33,9 +35,18 @@ pub fn describe_files(
     for (i, path) in files.iter().enumerate() {
         let file = path.display().to_string();
         let (entry, text) = if brtf_gonio::klems::is_klems_file(path) {
-            let summary = brtf_gonio::klems::read_path(path)?.info();
-            let text = summary.to_string();
-            (Entry::Klems(FileSummary { file, summary }), text)
+            match brtf_gonio::klems::read_any_path(path)? {
+                BsdfXml::Klems(bsdf) => {
+                    let summary = bsdf.info();
+                    let text = summary.to_string();
+                    (Entry::Klems(FileSummary { file, summary }), text)
+                }
+                BsdfXml::TensorTree(tree) => {
+                    let summary = tree.info();
+                    let text = summary.to_string();
+                    (Entry::Tree(FileSummary { file, summary }), text)
+                }
+            }
         } else {
             let summary = brtf_gonio::read_path(path)?.summary();
             let text = summary.to_string();

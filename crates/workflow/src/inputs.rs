@@ -74,7 +74,10 @@ pub fn default_name(files: &[PathBuf], klems: bool) -> Result<String, WorkflowEr
     for file in files {
         let name = if klems {
             // genBSDF writes `<Name>Name</Name>` when given none.
-            let name = brtf_gonio::klems::read_path(file)?.header.name;
+            let name = brtf_gonio::klems::read_any_path(file)?
+                .header()
+                .name
+                .clone();
             name.filter(|n| {
                 let n = n.trim().to_ascii_lowercase();
                 !["", "name", "unnamed", "untitled"].contains(&n.as_str())
@@ -109,7 +112,7 @@ pub(crate) fn klems_sides(
 ) -> Result<Vec<brtf_gonio::klems::Side>, WorkflowError> {
     let mut sides = Vec::new();
     for file in files {
-        for side in brtf_gonio::klems::read_path(file)?.sides_present() {
+        for side in brtf_gonio::klems::read_any_path(file)?.sides_present() {
             if !sides.contains(&side) {
                 sides.push(side);
             }

@@ -35,7 +35,7 @@ pub use amend::{
     Amended, check_folder, ensure_fit_json, export_into, export_klems_of_material,
     klems_of_fit_folder, plot_folder, read_fit, write_klems_into,
 };
-pub use directions::{parse_direction_line, parse_numbers};
+pub use directions::{ThetaGrid, parse_direction_line, parse_numbers};
 pub use en14501::en14501_material;
 pub use error::WorkflowError;
 pub use folder::{FolderWritten, Outputs, save_fit, write_fit_folder};

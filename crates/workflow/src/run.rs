@@ -132,7 +132,7 @@ pub fn fit_to_folder(
             if let [only] = present[..] {
                 wanted = vec![only];
                 notes.push(format!(
-                    "note: the Klems file holds the {only} side only (light from {}): that side is fitted",
+                    "note: the BSDF XML file holds the {only} side only (light from {}): that side is fitted",
                     if only == Side::Front { "+z" } else { "−z" }
                 ));
             }

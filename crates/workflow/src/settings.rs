@@ -77,6 +77,8 @@ pub struct FitSettings {
     pub patch_samples: usize,
     /// Raised to stop the fit (Python's Ctrl-C): see [`brtf_fit::StopFlag`].
     pub stop: brtf_fit::StopFlag,
+    /// Tensor trees: the θ_in fitted (degrees); the Klems rings' when `None`.
+    pub theta_in_grid: Option<crate::ThetaGrid>,
 }
 
 impl FitSettings {
@@ -111,6 +113,7 @@ impl FitSettings {
             incidences: None,
             patch_samples: brtf_fit::PatchAveraging::default().outgoing_samples,
             stop: brtf_fit::StopFlag::default(),
+            theta_in_grid: None,
         }
     }
 
@@ -125,6 +128,11 @@ impl FitSettings {
         if !klems && self.incidences.is_some() {
             return Err(WorkflowError::Usage(
                 "--incidences selects the incident patches of Klems BSDF XML files".into(),
+            ));
+        }
+        if !klems && self.theta_in_grid.is_some() {
+            return Err(WorkflowError::Usage(
+                "--theta-in-grid sets the incidences of tensor-tree BSDF XML files".into(),
             ));
         }
         if klems && self.phi_offset.is_some() {
@@ -218,6 +226,7 @@ impl FitSettings {
             klems: brtf_fit::KlemsOptions {
                 side: None,
                 incidences: self.incidences.clone(),
+                theta_in_grid: self.theta_in_grid.as_ref().map(|g| g.0.clone()),
             },
             auto,
         };

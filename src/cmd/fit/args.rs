@@ -15,9 +15,10 @@ use std::path::PathBuf;
 #[derive(Args, Debug)]
 pub(crate) struct FitArgs {
     /// Measurement files, one incidence each (.mpc or pab-opto Mountain); or
-    /// Klems BSDF XML files (each incident patch of a side an incidence,
-    /// docs/klems.md); or sample folders, one sample each (its .mpc and
-    /// .txt files), each fitted into OUT/<name>/.
+    /// Klems BSDF XML files (each incident patch of a side an incidence;
+    /// tensor trees: each --theta-in-grid angle, docs/klems.md); or sample
+    /// folders, one sample each (its .mpc and .txt files), each fitted into
+    /// OUT/<name>/.
     #[arg(required_unless_present = "en14501")]
     pub files: Vec<PathBuf>,
     /// Model to fit; `auto` fits plastic or metal, its anisotropic type,
@@ -133,6 +134,9 @@ pub(crate) struct FitArgs {
     /// model is averaged.
     #[arg(long, default_value_t = brtf_fit::PatchAveraging::default().outgoing_samples)]
     pub patch_samples: usize,
+    /// Tensor trees: the θ_in fitted, e.g. `0,15,30,45,60,75` [default: 0,10,…,70,82.5].
+    #[arg(long, value_parser = |s: &str| s.parse::<brtf_workflow::ThetaGrid>())]
+    pub theta_in_grid: Option<brtf_workflow::ThetaGrid>,
 }
 
 impl FitArgs {
@@ -168,6 +172,7 @@ impl FitArgs {
             sides: self.side,
             incidences: self.incidences.clone(),
             patch_samples: self.patch_samples,
+            theta_in_grid: self.theta_in_grid.clone(),
             ..FitSettings::new(model)
         })
     }

@@ -21,6 +21,7 @@
 mod basis;
 mod model_matrix;
 mod read;
+pub mod ttree;
 mod write;
 
 use std::fmt;
@@ -35,7 +36,35 @@ pub use basis::{BasisSize, KlemsBasis, KlemsPatch, KlemsRing};
 pub use model_matrix::{
     DEFAULT_SAMPLES, SampleOptions, SideMatrices, band_values, light_vector, side_matrices,
 };
-pub use read::{read_bytes, read_path, read_str};
+pub use read::{read_any_bytes, read_any_path, read_bytes, read_path, read_str};
+pub use ttree::{TensorTree, TreeInfo, TreeRank};
+
+/// A BSDF XML file of either kind.
+#[derive(Clone, Debug, PartialEq)]
+pub enum BsdfXml {
+    /// Klems matrices (`Columns` or `Rows`).
+    Klems(KlemsBsdf),
+    /// A tensor tree (`TensorTree3` or `TensorTree4`).
+    TensorTree(TensorTree),
+}
+
+impl BsdfXml {
+    /// The `Material` header.
+    pub fn header(&self) -> &KlemsHeader {
+        match self {
+            BsdfXml::Klems(b) => &b.header,
+            BsdfXml::TensorTree(t) => &t.header,
+        }
+    }
+
+    /// The sides with Visible data, front first.
+    pub fn sides_present(&self) -> Vec<Side> {
+        match self {
+            BsdfXml::Klems(b) => b.sides_present(),
+            BsdfXml::TensorTree(t) => t.sides_present(),
+        }
+    }
+}
 pub use write::{KlemsWriteBlock, KlemsWriteHeader, WindowFields, to_klems_xml};
 
 /// Values below this are refused; values between it and 0 read as 0.

@@ -9,8 +9,9 @@ use std::path::Path;
 use rayon::prelude::*;
 use roxmltree::{Document, Node};
 
+use super::ttree::TreeRank;
 use super::{
-    KlemsBand, KlemsBasis, KlemsBsdf, KlemsDirection, KlemsHeader, KlemsMatrix, KlemsRing,
+    BsdfXml, KlemsBand, KlemsBasis, KlemsBsdf, KlemsDirection, KlemsHeader, KlemsMatrix, KlemsRing,
     NEGATIVE_LIMIT,
 };
 use crate::error::{KlemsProblem, ParseErrorKind, ReadError};
@@ -29,9 +30,31 @@ pub fn read_bytes(bytes: &[u8], name: impl AsRef<Path>) -> Result<KlemsBsdf, Rea
     read_str(&text, name)
 }
 
-/// Parses in-memory text; `name` is used in errors.
+/// Reads a BSDF XML file of either kind: a Klems matrix file or a
+/// tensor tree.
+pub fn read_any_path(path: &Path) -> Result<BsdfXml, ReadError> {
+    let bytes = read_file(path)?;
+    read_any_bytes(&bytes, path)
+}
+
+/// [`read_any_path`] on in-memory bytes; `name` is used in errors.
+pub fn read_any_bytes(bytes: &[u8], name: impl AsRef<Path>) -> Result<BsdfXml, ReadError> {
+    let name = name.as_ref();
+    let text = check_text(bytes, name)?;
+    let doc = parse_document(&text, name)?;
+    Reader { doc: &doc, name }.read_any()
+}
+
+/// Parses in-memory text as a Klems matrix file (a tensor tree is refused:
+/// [`read_any_bytes`] reads both); `name` is used in errors.
 pub fn read_str(text: &str, name: impl AsRef<Path>) -> Result<KlemsBsdf, ReadError> {
     let name = name.as_ref();
+    let doc = parse_document(text, name)?;
+    Reader { doc: &doc, name }.read()
+}
+
+/// The XML document, with the attribute guard.
+fn parse_document<'t>(text: &'t str, name: &Path) -> Result<Document<'t>, ReadError> {
     if let Some((line, count)) = crowded_element(text) {
         return Err(parse_error(
             name,
@@ -44,7 +67,7 @@ pub fn read_str(text: &str, name: impl AsRef<Path>) -> Result<KlemsBsdf, ReadErr
             },
         ));
     }
-    let doc = Document::parse(text).map_err(|e| {
+    Document::parse(text).map_err(|e| {
         let line = (e.pos().row as usize).max(1);
         parse_error(
             name,
@@ -54,8 +77,7 @@ pub fn read_str(text: &str, name: impl AsRef<Path>) -> Result<KlemsBsdf, ReadErr
                 problem: KlemsProblem::Xml(e.to_string()),
             },
         )
-    })?;
-    Reader { doc: &doc, name }.read()
+    })
 }
 
 /// Attributes per element beyond which a file is refused: a BSDF file's
@@ -101,13 +123,13 @@ fn crowded_element(text: &str) -> Option<(usize, usize)> {
     None
 }
 
-struct Reader<'a, 'input> {
-    doc: &'a Document<'input>,
-    name: &'a Path,
+pub(super) struct Reader<'a, 'input> {
+    pub(super) doc: &'a Document<'input>,
+    pub(super) name: &'a Path,
 }
 
 /// Element children of `node` with local name `tag`.
-fn children<'a, 'input: 'a>(
+pub(super) fn children<'a, 'input: 'a>(
     node: Node<'a, 'input>,
     tag: &'static str,
 ) -> impl Iterator<Item = Node<'a, 'input>> {
@@ -115,22 +137,25 @@ fn children<'a, 'input: 'a>(
         .filter(move |c| c.is_element() && c.tag_name().name() == tag)
 }
 
-fn child<'a, 'input>(node: Node<'a, 'input>, tag: &'static str) -> Option<Node<'a, 'input>> {
+pub(super) fn child<'a, 'input>(
+    node: Node<'a, 'input>,
+    tag: &'static str,
+) -> Option<Node<'a, 'input>> {
     children(node, tag).next()
 }
 
 /// The trimmed text of a child, `None` when absent or empty.
-fn child_text(node: Node<'_, '_>, tag: &'static str) -> Option<String> {
+pub(super) fn child_text(node: Node<'_, '_>, tag: &'static str) -> Option<String> {
     let text = child(node, tag)?.text()?.trim();
     (!text.is_empty()).then(|| text.to_string())
 }
 
 impl<'a, 'input> Reader<'a, 'input> {
-    fn line_of(&self, node: Node<'_, '_>) -> usize {
+    pub(super) fn line_of(&self, node: Node<'_, '_>) -> usize {
         (self.doc.text_pos_at(node.range().start).row as usize).max(1)
     }
 
-    fn error(&self, node: Node<'_, '_>, problem: KlemsProblem) -> ReadError {
+    pub(super) fn error(&self, node: Node<'_, '_>, problem: KlemsProblem) -> ReadError {
         parse_error(
             self.name,
             self.line_of(node),
@@ -141,7 +166,7 @@ impl<'a, 'input> Reader<'a, 'input> {
         )
     }
 
-    fn required(
+    pub(super) fn required(
         &self,
         parent: Node<'a, 'input>,
         tag: &'static str,
@@ -149,7 +174,21 @@ impl<'a, 'input> Reader<'a, 'input> {
         child(parent, tag).ok_or_else(|| self.error(parent, KlemsProblem::Missing(tag)))
     }
 
-    fn read(&self) -> Result<KlemsBsdf, ReadError> {
+    /// The first layer, its header, its `DataDefinition` and the
+    /// `IncidentDataStructure` element with its trimmed text.
+    #[allow(clippy::type_complexity)]
+    fn layer(
+        &self,
+    ) -> Result<
+        (
+            Node<'a, 'input>,
+            KlemsHeader,
+            Node<'a, 'input>,
+            Node<'a, 'input>,
+            String,
+        ),
+        ReadError,
+    > {
         let root = self.doc.root_element();
         if root.tag_name().name() != "WindowElement" {
             return Err(self.error(
@@ -164,10 +203,27 @@ impl<'a, 'input> Reader<'a, 'input> {
             .unwrap_or_default();
         header.file_type = child_text(root, "FileType");
         header.window_element_type = child_text(root, "WindowElementType");
-
         let definition = self.required(layer, "DataDefinition")?;
         let structure_node = self.required(definition, "IncidentDataStructure")?;
         let structure = structure_node.text().unwrap_or("").trim().to_string();
+        Ok((layer, header, definition, structure_node, structure))
+    }
+
+    /// A Klems matrix file or a tensor tree, by `IncidentDataStructure`.
+    fn read_any(&self) -> Result<BsdfXml, ReadError> {
+        let (layer, header, _, _, structure) = self.layer()?;
+        let rank = if structure.eq_ignore_ascii_case("tensortree3") {
+            TreeRank::Isotropic
+        } else if structure.eq_ignore_ascii_case("tensortree4") {
+            TreeRank::Anisotropic
+        } else {
+            return self.read().map(BsdfXml::Klems);
+        };
+        super::ttree::read_tree(self, layer, header, rank).map(BsdfXml::TensorTree)
+    }
+
+    fn read(&self) -> Result<KlemsBsdf, ReadError> {
+        let (layer, header, definition, structure_node, structure) = self.layer()?;
         let rows = if structure.eq_ignore_ascii_case("columns") {
             false
         } else if structure.eq_ignore_ascii_case("rows") {
@@ -567,7 +623,7 @@ struct ParsedMatrix {
     clipped: usize,
 }
 
-fn material_header(material: Node<'_, '_>) -> KlemsHeader {
+pub(super) fn material_header(material: Node<'_, '_>) -> KlemsHeader {
     let mut header = KlemsHeader {
         manufacturer: child_text(material, "Manufacturer"),
         name: child_text(material, "Name"),
@@ -591,7 +647,7 @@ fn material_header(material: Node<'_, '_>) -> KlemsHeader {
 }
 
 /// At most 40 characters of `text`, for messages.
-fn shorten(text: &str) -> String {
+pub(super) fn shorten(text: &str) -> String {
     match text.char_indices().nth(40) {
         Some((cut, _)) => format!("{}...", &text[..cut]),
         None => text.to_string(),
