@@ -123,6 +123,19 @@ fn push_value(out: &mut Vec<u8>, x: f64) {
         out.push(b'-');
     }
     let a = x.abs();
+    // Near the ends of f64 the scaling below under- or overflows (10^(e−6)
+    // of a subnormal is 0): the standard formatter does those few.
+    if !(1e-290..=1e290).contains(&a) {
+        let text = format!("{a:.6e}");
+        let (mantissa, exponent) = text.split_once('e').unwrap_or((&text, "0"));
+        let mantissa = mantissa.trim_end_matches('0').trim_end_matches('.');
+        out.extend_from_slice(mantissa.as_bytes());
+        if exponent != "0" {
+            out.push(b'e');
+            out.extend_from_slice(exponent.as_bytes());
+        }
+        return;
+    }
     let mut exponent = a.log10().floor() as i32;
     let mut mantissa = (a / 10f64.powi(exponent - 6)).round() as u64;
     if mantissa >= 10_000_000 {
@@ -202,6 +215,12 @@ mod tests {
         assert_eq!(value(9.9999999), "1e1");
         assert_eq!(value(123456789.0), "1.234568e8");
         assert_eq!(value(f64::NAN), "");
+        // The ends of f64: subnormals and the largest values.
+        assert_eq!(value(4.9e-324), "4.940656e-324");
+        assert_eq!(value(-f64::MIN_POSITIVE), "-2.225074e-308");
+        assert_eq!(value(1e300), "1e300");
+        assert_eq!(value(f64::MAX), "1.797693e308");
+        assert_eq!(value(2.5e-295), "2.5e-295");
         for x in [
             1e-300,
             3.7e-5,
