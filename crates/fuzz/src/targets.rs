@@ -58,17 +58,7 @@ fn tensor_tree(bytes: &[u8], name: &str) -> Outcome {
     let tree = match brtf_gonio::klems::read_any_bytes(bytes, name) {
         Ok(BsdfXml::TensorTree(tree)) => tree,
         Ok(BsdfXml::Klems(_)) => return Outcome::Accepted,
-        Err(e) => {
-            let message = e.to_string();
-            let lines = line_count(bytes, true);
-            return match e.line() {
-                Some(line) if line == 0 || line > lines => anomaly(
-                    "error line outside the file",
-                    format!("error on line {line} of a {lines}-line file: {message}"),
-                ),
-                _ => located(message, name),
-            };
-        }
+        Err(e) => return refused(e.to_string(), e.line(), bytes, name),
     };
     let info = tree.info();
     let _ = info.to_string();
@@ -139,17 +129,7 @@ fn gonio(bytes: &[u8], name: &str, format: Option<SourceFormat>) -> Outcome {
     };
     let measurement = match result {
         Ok(m) => m,
-        Err(e) => {
-            let message = e.to_string();
-            let lines = line_count(bytes, true);
-            return match e.line() {
-                Some(line) if line == 0 || line > lines => anomaly(
-                    "error line outside the file",
-                    format!("error on line {line} of a {lines}-line file: {message}"),
-                ),
-                _ => located(message, name),
-            };
-        }
+        Err(e) => return refused(e.to_string(), e.line(), bytes, name),
     };
     let _ = measurement.summary();
     if let Some((class, detail)) = round_trip(&measurement, name) {
@@ -213,26 +193,28 @@ fn residuals_csv(measurement: Measurement, name: &str) -> Option<(&'static str, 
     })
 }
 
+/// A refusal with `message` at `line`: an anomaly when the line lies
+/// outside the file (lone `\r` count as line ends, as editors and the
+/// text readers count them; the XML parser counts `\n` only, so a line is
+/// outside only beyond both counts), else as [`located`] judges it.
+fn refused(message: String, line: Option<usize>, bytes: &[u8], name: &str) -> Outcome {
+    let lines = line_count(bytes, true);
+    match line {
+        Some(line) if line == 0 || line > lines => anomaly(
+            "error line outside the file",
+            format!("error on line {line} of a {lines}-line file: {message}"),
+        ),
+        _ => located(message, name),
+    }
+}
+
 /// The Klems reader, then what `brtf info` and the conversion to
 /// measurements do with an accepted file, and (`round_trip`) brtf's
 /// writer and a read back.
 fn klems(bytes: &[u8], name: &str, round_trip: bool) -> Outcome {
     let bsdf = match brtf_gonio::klems::read_bytes(bytes, name) {
         Ok(b) => b,
-        Err(e) => {
-            let message = e.to_string();
-            // The XML parser counts `\n` only, the text check lone `\r`
-            // too (as editors do): a line is outside the file only when it
-            // is beyond both counts.
-            let lines = line_count(bytes, true);
-            return match e.line() {
-                Some(line) if line == 0 || line > lines => anomaly(
-                    "error line outside the file",
-                    format!("error on line {line} of a {lines}-line file: {message}"),
-                ),
-                _ => located(message, name),
-            };
-        }
+        Err(e) => return refused(e.to_string(), e.line(), bytes, name),
     };
     let info = bsdf.info();
     let _ = info.to_string();

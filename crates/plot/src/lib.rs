@@ -349,15 +349,7 @@ fn plot(
     // model beside every sample). Nothing here is made on first use, so
     // no thread waits for another's lazy value inside the joins.
     let (loaded, grids): (Vec<Result<Incidence, String>>, Vec<_>) = rayon::join(
-        || {
-            (0..result.incidences.len())
-                .into_par_iter()
-                .map(|k| match prepared.get(k) {
-                    Some(data) => prepare::from_prepared(result, k, tags[k].clone(), data),
-                    None => prepare::load(result, k, tags[k].clone(), dir, &options.search_dirs),
-                })
-                .collect()
-        },
+        || load_all(dir, result, prepared, options),
         || {
             prepared
                 .par_iter()
@@ -382,12 +374,7 @@ fn plot(
     let by_index: Vec<Option<&Incidence>> = loaded.iter().map(|l| l.as_ref().ok()).collect();
     // Two passes over every fitted sample, at the same time.
     let (ratio, medians) = rayon::join(
-        || {
-            options
-                .ratio
-                .filter(|r| r.is_finite() && *r > 1.0)
-                .unwrap_or_else(|| auto_ratio(&incs))
-        },
+        || map_ratio(options, &incs),
         || -> Vec<Option<f64>> {
             by_index
                 .par_iter()
@@ -495,13 +482,7 @@ fn plot(
     let report_path = dir.join("report.html");
     // Every grid a chart asks for (a map without fitted samples draws an
     // empty front disk).
-    let wanted = |inc: &Incidence| {
-        let mut hemispheres = inc.hemispheres();
-        if hemispheres.is_empty() {
-            hemispheres.push(brtf_gonio::Hemisphere::Front);
-        }
-        hemispheres
-    };
+    let wanted = Incidence::drawn_hemispheres;
     let grids = || {
         incs.par_iter().for_each(|inc| {
             for hemisphere in wanted(inc) {
@@ -539,20 +520,13 @@ pub fn view_html(
     if result.incidences.is_empty() {
         return Err(PlotError::NoIncidences);
     }
-    let tags = prepare::tags(&result.incidences);
-    let loaded: Vec<Result<Incidence, String>> = (0..result.incidences.len())
-        .into_par_iter()
-        .map(|k| prepare::load(result, k, tags[k].clone(), dir, &options.search_dirs))
-        .collect();
+    let loaded = load_all(dir, result, &[], options);
     let incs: Vec<&Incidence> = loaded.iter().filter_map(|l| l.as_ref().ok()).collect();
     if incs.is_empty() {
         let why = loaded.into_iter().find_map(Result::err).unwrap_or_default();
         return Err(PlotError::NoData(why));
     }
-    let ratio = options
-        .ratio
-        .filter(|r| r.is_finite() && *r > 1.0)
-        .unwrap_or_else(|| auto_ratio(&incs));
+    let ratio = map_ratio(options, &incs);
     static VIEWS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
     let serial = VIEWS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let nanos = std::time::SystemTime::now()
@@ -564,6 +538,32 @@ pub fn view_html(
         viewer::STYLE,
         viewer::html(result, &incs, ratio, &id)
     ))
+}
+
+/// Every incidence of `result` with the model beside its samples: from
+/// `prepared[k]` when given, else read from its file; or why not.
+fn load_all(
+    dir: &Path,
+    result: &FitResult,
+    prepared: &[PreparedMeasurement],
+    options: &PlotOptions,
+) -> Vec<Result<Incidence, String>> {
+    let tags = prepare::tags(&result.incidences);
+    (0..result.incidences.len())
+        .into_par_iter()
+        .map(|k| match prepared.get(k) {
+            Some(data) => prepare::from_prepared(result, k, tags[k].clone(), data),
+            None => prepare::load(result, k, tags[k].clone(), dir, &options.search_dirs),
+        })
+        .collect()
+}
+
+/// The maps' colour-bar ratio: `--ratio`, else [`auto_ratio`].
+fn map_ratio(options: &PlotOptions, incs: &[&Incidence]) -> f64 {
+    options
+        .ratio
+        .filter(|r| r.is_finite() && *r > 1.0)
+        .unwrap_or_else(|| auto_ratio(incs))
 }
 
 /// `name` then `rest` as `chart`'s title, the name shortened to fit the

@@ -216,6 +216,16 @@ impl Incidence {
             .clone()
     }
 
+    /// The hemispheres a map or the 3D view's surface draws: those
+    /// holding fitted samples, or the front alone when none does.
+    pub fn drawn_hemispheres(&self) -> Vec<Hemisphere> {
+        let mut hemispheres = self.hemispheres();
+        if hemispheres.is_empty() {
+            hemispheres.push(Hemisphere::Front);
+        }
+        hemispheres
+    }
+
     /// Mirror direction (θ_in, φ_in + 180°).
     pub fn mirror(&self) -> DVec3 {
         DVec3::new(-self.light.x, -self.light.y, self.light.z)

@@ -18,16 +18,6 @@ pub(crate) fn size(samples: usize) -> usize {
     side.clamp(25, 97) | 1
 }
 
-/// The hemispheres that hold fitted samples, front first (the front
-/// alone when none does): where a surface is drawn.
-pub(crate) fn hemispheres(inc: &Incidence) -> Vec<Hemisphere> {
-    let mut used = inc.hemispheres();
-    if used.is_empty() {
-        used.push(Hemisphere::Front);
-    }
-    used
-}
-
 /// The direction at unit-disk position `(u, v)` of `hemisphere` (the
 /// inverse of the equal-area projection), `None` outside the disk.
 fn direction(u: f64, v: f64, hemisphere: Hemisphere) -> Option<DVec3> {

@@ -135,7 +135,7 @@ fn incidence_json(result: &FitResult, inc: &Incidence) -> Value {
     }
     bytes.extend(&flags);
 
-    let hemispheres = grid::hemispheres(inc);
+    let hemispheres = inc.drawn_hemispheres();
     let mut surfaces = vec![json!({
         "label": format!("{} (fitted)", result.config.shape().label()),
         "codes": base64(&grid::surface(inc, &hemispheres, |v| inc.model_at(v), lo, hi)),
