@@ -497,7 +497,7 @@
   canvas.addEventListener('pointercancel', release);
   canvas.addEventListener('pointermove', function (e) {
     var p = pointers[e.pointerId];
-    if (!p) { hover(e); return; }
+    if (!p) { hoverSoon(e); return; }
     var ids = Object.keys(pointers);
     if (ids.length >= 2) {
       var a = pointers[ids[0]], b = pointers[ids[1]];
@@ -521,6 +521,16 @@
   function zoom(f) { view.dist = Math.max(0.8, Math.min(15, view.dist * f)); move(); }
   canvas.addEventListener('wheel', function (e) { e.preventDefault(); zoom(Math.exp(e.deltaY * 0.001)); }, { passive: false });
   canvas.addEventListener('pointerleave', function () { tip.hidden = true; });
+
+  // One search per frame however often the pointer moves (a search looks
+  // at every sample).
+  var hoverEvent = null;
+  function hoverSoon(e) {
+    if (hoverEvent === null) {
+      requestAnimationFrame(function () { var last = hoverEvent; hoverEvent = null; hover(last); });
+    }
+    hoverEvent = e;
+  }
 
   // The sample nearest the pointer on screen (within 10 px), nearest the
   // eye among equals.
