@@ -90,30 +90,144 @@ pub struct IncidenceData {
 /// smooth function of the parameters.
 ///
 /// A Klems side has ~10 million pairs but only a few thousand distinct
-/// directions, so pairs are stored as two indices into a direction table
-/// (8 bytes a pair instead of 48).
+/// directions, and each sample's pairs follow a pattern over them (every
+/// light with every view, or each view with one light in turn), so a
+/// sample is stored as its pattern and two index ranges into a direction
+/// table: a side's pairs take kilobytes, not the 80 MB of listed indices.
+/// Pairs without a pattern are listed as (light, view) indices.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct PatchPairs {
-    /// Start of sample i's pairs is `offsets[i]`, its end `offsets[i + 1]`.
-    pub offsets: Vec<usize>,
-    /// The unit vectors the pairs use.
-    pub directions: Vec<DVec3>,
-    /// Per pair, the index in `directions` of the vector towards the light.
-    pub light_index: Vec<u32>,
-    /// Per pair, the index in `directions` of the vector towards the
-    /// detector.
-    pub view_index: Vec<u32>,
+    /// The unit vectors the pairs use, shared by selections.
+    directions: Arc<Vec<DVec3>>,
+    /// Per sample, its pairs.
+    samples: Vec<SamplePairs>,
+    /// Listed pairs' indices in `directions`: towards the light, towards
+    /// the detector.
+    listed_lights: Vec<u32>,
+    listed_views: Vec<u32>,
+    pair_count: usize,
 }
+
+/// One sample's pairs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum SamplePairs {
+    /// Every light of `lights` with every view of `views` (light-major).
+    Product {
+        lights: IndexRange,
+        views: IndexRange,
+    },
+    /// View k of `views` with light k mod |lights| of `lights`.
+    Zip {
+        lights: IndexRange,
+        views: IndexRange,
+    },
+    /// View k of `views` with light (k · 7 + 3) mod |lights| of `lights`:
+    /// a product's coarse stand-in. Lights and views are drawn from
+    /// strata in the same order, so pairing stratum k with stratum k
+    /// would pair nearly aligned directions on a straight-through patch.
+    Shuffled {
+        lights: IndexRange,
+        views: IndexRange,
+    },
+    /// Listed pairs `start..end` of the listed indices.
+    Listed { start: usize, end: usize },
+}
+
+/// `start..start + len` of the direction table.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct IndexRange {
+    start: u32,
+    len: u32,
+}
+
+impl IndexRange {
+    fn new(range: std::ops::Range<u32>) -> IndexRange {
+        IndexRange {
+            start: range.start,
+            len: range.end.saturating_sub(range.start),
+        }
+    }
+}
+
+impl SamplePairs {
+    fn count(&self) -> usize {
+        match *self {
+            SamplePairs::Product { lights, views } => lights.len as usize * views.len as usize,
+            // No light, no pair.
+            SamplePairs::Zip { lights, views } | SamplePairs::Shuffled { lights, views } => {
+                views.len as usize * usize::from(lights.len > 0)
+            }
+            SamplePairs::Listed { start, end } => end - start,
+        }
+    }
+
+    /// Pair `k`'s (light, view) indices; listed pairs read `lights` and
+    /// `views`.
+    #[inline]
+    fn pair(&self, k: usize, lights: &[u32], views: &[u32]) -> (usize, usize) {
+        match *self {
+            SamplePairs::Product { lights, views } => {
+                let n = views.len as usize;
+                (lights.start as usize + k / n, views.start as usize + k % n)
+            }
+            SamplePairs::Zip { lights, views } => (
+                lights.start as usize + k % lights.len as usize,
+                views.start as usize + k,
+            ),
+            SamplePairs::Shuffled { lights, views } => (
+                lights.start as usize + (k * 7 + 3) % lights.len as usize,
+                views.start as usize + k,
+            ),
+            SamplePairs::Listed { start, .. } => {
+                (lights[start + k] as usize, views[start + k] as usize)
+            }
+        }
+    }
+}
+
+/// Most pairs per sample in [`PatchPairs::coarse`].
+const COARSE_PAIRS: usize = 32;
 
 impl PatchPairs {
     /// No samples yet; pairs will index `directions`.
     pub fn new(directions: Vec<DVec3>) -> PatchPairs {
         PatchPairs {
-            offsets: vec![0],
-            directions,
-            light_index: Vec::new(),
-            view_index: Vec::new(),
+            directions: Arc::new(directions),
+            ..PatchPairs::default()
         }
+    }
+
+    /// No samples yet; pairs will index `directions`, shared with other
+    /// pairs.
+    pub fn sharing(directions: Arc<Vec<DVec3>>) -> PatchPairs {
+        PatchPairs {
+            directions,
+            ..PatchPairs::default()
+        }
+    }
+
+    /// The unit vectors the pairs index.
+    pub fn directions(&self) -> &[DVec3] {
+        &self.directions
+    }
+
+    /// Appends `directions` to the table; their indices.
+    pub fn add_directions(
+        &mut self,
+        directions: impl IntoIterator<Item = DVec3>,
+    ) -> std::ops::Range<u32> {
+        let table = Arc::make_mut(&mut self.directions);
+        let first = table.len() as u32;
+        table.extend(directions);
+        first..table.len() as u32
+    }
+
+    fn check(&self, range: &std::ops::Range<u32>) {
+        assert!(
+            range.start <= range.end && range.end as usize <= self.directions.len(),
+            "PatchPairs: index outside the {} directions",
+            self.directions.len()
+        );
     }
 
     /// Appends one sample's pairs, as (light, view) indices into
@@ -123,20 +237,55 @@ impl PatchPairs {
     /// If an index is outside `directions`.
     pub fn push(&mut self, pairs: impl IntoIterator<Item = (u32, u32)>) {
         let n = self.directions.len();
+        let start = self.listed_lights.len();
         for (light, view) in pairs {
             assert!(
                 (light as usize) < n && (view as usize) < n,
                 "PatchPairs::push: index outside the {n} directions"
             );
-            self.light_index.push(light);
-            self.view_index.push(view);
+            self.listed_lights.push(light);
+            self.listed_views.push(view);
         }
-        self.offsets.push(self.light_index.len());
+        let end = self.listed_lights.len();
+        self.add(SamplePairs::Listed { start, end });
+    }
+
+    /// Appends a sample averaged over every light of `lights` with every
+    /// view of `views` (index ranges of `directions`).
+    ///
+    /// # Panics
+    /// If a range reaches outside `directions`.
+    pub fn push_product(&mut self, lights: std::ops::Range<u32>, views: std::ops::Range<u32>) {
+        self.check(&lights);
+        self.check(&views);
+        self.add(SamplePairs::Product {
+            lights: IndexRange::new(lights),
+            views: IndexRange::new(views),
+        });
+    }
+
+    /// Appends a sample averaged over each view of `views` with one light
+    /// of `lights` in turn.
+    ///
+    /// # Panics
+    /// If a range reaches outside `directions`.
+    pub fn push_zip(&mut self, lights: std::ops::Range<u32>, views: std::ops::Range<u32>) {
+        self.check(&lights);
+        self.check(&views);
+        self.add(SamplePairs::Zip {
+            lights: IndexRange::new(lights),
+            views: IndexRange::new(views),
+        });
+    }
+
+    fn add(&mut self, sample: SamplePairs) {
+        self.pair_count += sample.count();
+        self.samples.push(sample);
     }
 
     /// How many samples.
     pub fn len(&self) -> usize {
-        self.offsets.len().saturating_sub(1)
+        self.samples.len()
     }
 
     /// True when there are no samples.
@@ -146,28 +295,67 @@ impl PatchPairs {
 
     /// How many pairs in all.
     pub fn pair_count(&self) -> usize {
-        self.light_index.len()
+        self.pair_count
+    }
+
+    /// How many pairs sample `i` has.
+    pub fn count(&self, i: usize) -> usize {
+        self.samples[i].count()
     }
 
     /// The pairs of sample `i`, as (light, view) vectors.
     #[inline]
     pub fn of(&self, i: usize) -> impl ExactSizeIterator<Item = (DVec3, DVec3)> + '_ {
-        let range = self.offsets[i]..self.offsets[i + 1];
-        self.light_index[range.clone()]
-            .iter()
-            .zip(&self.view_index[range])
-            .map(|(&l, &v)| (self.directions[l as usize], self.directions[v as usize]))
+        let sample = self.samples[i];
+        (0..sample.count()).map(move |k| {
+            let (l, v) = sample.pair(k, &self.listed_lights, &self.listed_views);
+            (self.directions[l], self.directions[v])
+        })
     }
 
     /// The pairs of the samples `indices`, in that order.
     pub fn select(&self, indices: impl IntoIterator<Item = usize>) -> PatchPairs {
-        let mut out = PatchPairs::new(self.directions.clone());
+        let mut out = PatchPairs {
+            directions: Arc::clone(&self.directions),
+            listed_lights: self.listed_lights.clone(),
+            listed_views: self.listed_views.clone(),
+            ..PatchPairs::default()
+        };
         for i in indices {
-            let range = self.offsets[i]..self.offsets[i + 1];
-            out.light_index
-                .extend_from_slice(&self.light_index[range.clone()]);
-            out.view_index.extend_from_slice(&self.view_index[range]);
-            out.offsets.push(out.light_index.len());
+            out.add(self.samples[i]);
+        }
+        out
+    }
+
+    /// The same samples with at most a few dozen pairs each: every view of
+    /// a product with one light in turn (as the samples far from a lobe
+    /// are averaged), listed pairs thinned evenly. Its averages are
+    /// coarser but cost a fraction: the starts of a fit run on them.
+    pub fn coarse(&self) -> PatchPairs {
+        let mut out = PatchPairs {
+            directions: Arc::clone(&self.directions),
+            ..PatchPairs::default()
+        };
+        for sample in &self.samples {
+            match *sample {
+                SamplePairs::Product { lights, views } => {
+                    out.add(SamplePairs::Shuffled { lights, views });
+                }
+                SamplePairs::Zip { .. } | SamplePairs::Shuffled { .. } => out.add(*sample),
+                SamplePairs::Listed { start, end } => {
+                    let step = (end - start).div_ceil(COARSE_PAIRS).max(1);
+                    let first = out.listed_lights.len();
+                    for k in (start..end).step_by(step) {
+                        out.listed_lights.push(self.listed_lights[k]);
+                        out.listed_views.push(self.listed_views[k]);
+                    }
+                    let last = out.listed_lights.len();
+                    out.add(SamplePairs::Listed {
+                        start: first,
+                        end: last,
+                    });
+                }
+            }
         }
         out
     }

@@ -39,9 +39,6 @@ const BRIGHT_SAMPLES: usize = 250;
 const POLISH_SAMPLES: usize = 2000;
 /// Multi-start ends polished and compared on every sample.
 const CANDIDATES: usize = 3;
-/// Most patch pairs whose geometry a fit keeps (48 bytes each): one Klems
-/// incidence has ~50 000.
-const GEOMETRY_CACHE_PAIRS: usize = 12_000_000;
 /// Robust reweighting stops when no parameter moves by more than this
 /// (relative) in a round...
 const IRLS_TOLERANCE: f64 = 1e-6;
@@ -73,8 +70,10 @@ pub(crate) enum SharedGeometry {
 }
 
 /// The geometry of each of `data`'s incidences (see [`SharedGeometry`]).
-/// Patch pairs are kept only within the cache budget, for all incidences
-/// or none.
+/// Patch pairs' geometry is kept for one incidence only (a few MB): a
+/// Klems side's 10 million pairs would take 0.5 GB, so fits over many
+/// incidences compute it on every pass (from coarse pairs until the last
+/// solve), and each incidence's own fit keeps its own while it runs.
 pub(crate) fn shared_geometry(
     data: &[IncidenceData],
     config: &FitConfig,
@@ -84,12 +83,7 @@ pub(crate) fn shared_geometry(
         return Ok(data.iter().map(|_| SharedGeometry::Recomputed).collect());
     }
     let bsdf = geometry_bsdf(config)?;
-    let total_pairs: usize = data
-        .iter()
-        .filter_map(|d| d.patch_pairs.as_deref())
-        .map(PatchPairs::pair_count)
-        .sum();
-    let keep_pairs = total_pairs <= GEOMETRY_CACHE_PAIRS;
+    let keep_pairs = data.len() == 1;
     Ok(data
         .par_iter()
         .map(|d| match d.patch_pairs.as_deref() {
@@ -180,12 +174,16 @@ fn fit_many(
             Some(fit_many(data, &one, label, geometry, None)?)
         }
     };
-    // The blocks' geometry once per fit, or the fit set's shared one.
+    // The blocks' geometry once per fit, or the fit set's shared one (an
+    // incidence's patch pairs are not shared: this fit keeps them).
     let own_geometry = match geometry {
+        Some([SharedGeometry::Recomputed]) if data[0].patch_pairs.is_some() => {
+            Some(shared_geometry(data, config)?)
+        }
         Some(_) => None,
         None => Some(shared_geometry(data, config)?),
     };
-    let geometry = geometry.or(own_geometry.as_deref()).unwrap_or_default();
+    let geometry = own_geometry.as_deref().or(geometry).unwrap_or_default();
     let mut blocks = Vec::with_capacity(data.len());
     let mut stats = Vec::with_capacity(data.len());
     for (k, d) in data.iter().enumerate() {
@@ -247,6 +245,43 @@ fn fit_many(
     for b in &mut blocks {
         b.set_factors(config.residual, floor);
     }
+    // Patch-averaged data: the starts average over coarse pairs (an
+    // eighth of a Klems incidence's), and so does an all-incidence fit
+    // until its last solve, which alone runs on every pair. The starts
+    // only choose a basin: an incidence's candidates are judged on every
+    // pair.
+    let coarse_pairs: Vec<Option<PatchPairs>> = blocks
+        .iter()
+        .map(|b| b.pairs.as_deref().map(PatchPairs::coarse))
+        .collect();
+    let coarse_geometry: Vec<Option<PairGeometry>> = if data.len() == 1 && !config.oriented {
+        let bsdf = geometry_bsdf(config)?;
+        coarse_pairs
+            .iter()
+            .map(|p| p.as_ref().map(|p| PairGeometry::new(p, &bsdf)))
+            .collect()
+    } else {
+        vec![None; blocks.len()]
+    };
+    let coarse_blocks: Option<Vec<Block>> = coarse_pairs.iter().any(Option::is_some).then(|| {
+        blocks
+            .iter()
+            .zip(coarse_pairs.iter().zip(&coarse_geometry))
+            .map(|(b, (pairs, geometry))| Block {
+                pairs: pairs.as_ref().map(Cow::Borrowed),
+                pair_geometry: geometry.as_ref().map(Cow::Borrowed),
+                ..b.clone()
+            })
+            .collect()
+    });
+    let start_blocks: &[Block] = coarse_blocks.as_deref().unwrap_or(&blocks);
+    // Where the candidates are judged: an incidence's on every pair, an
+    // all-incidence fit's on the coarse pairs of every sample.
+    let judge_blocks: &[Block] = if data.len() > 1 {
+        start_blocks
+    } else {
+        &blocks
+    };
     let solver = Solver {
         map: &map,
         config,
@@ -262,7 +297,7 @@ fn fit_many(
     // so the result is never worse than any candidate.
     let mut records = Vec::new();
     let thin = |target: usize| -> Vec<Block> {
-        blocks
+        start_blocks
             .iter()
             .zip(&bright)
             .map(|(b, &t)| prepare::subsample(b, share(target), t))
@@ -305,7 +340,7 @@ fn fit_many(
         ends = order.iter().map(|&i| solved[i].u.clone()).collect();
         let full_costs = candidates_full_costs(
             &solver,
-            &blocks,
+            judge_blocks,
             &mut ends,
             polish.then(|| thin(POLISH_SAMPLES)),
             start_stage,
@@ -324,7 +359,7 @@ fn fit_many(
     } else if polish {
         candidates_full_costs(
             &solver,
-            &blocks,
+            judge_blocks,
             &mut ends,
             Some(thin(POLISH_SAMPLES)),
             start_stage,
@@ -335,11 +370,17 @@ fn fit_many(
     // Over many incidences Gauss-Newton can converge linearly (a model
     // that cannot follow every incidence): extrapolated rounds there.
     let final_solve = |u: DVector<f64>| {
-        if data.len() > 1 {
-            solver.solve_final(&blocks, u)
-        } else {
-            solver.solve(&blocks, u, Stage::FINAL)
+        if data.len() == 1 {
+            return solver.solve(&blocks, u, Stage::FINAL);
         }
+        let approximate = solver.solve_final(start_blocks, u);
+        if coarse_blocks.is_none() || !approximate.cost.is_finite() {
+            return approximate;
+        }
+        // From the coarse pairs' minimum, a few passes over every pair.
+        let mut exact = solver.solve(&blocks, approximate.u, Stage::FINAL);
+        exact.evaluations += approximate.evaluations;
+        exact
     };
     let mut solved = final_solve(u_start);
     evaluations += solved.evaluations;

@@ -59,57 +59,110 @@ pub fn prepare_patch(
     at: KlemsPatchRef,
     source: &str,
 ) -> Result<Option<PreparedMeasurement>, RecipeError> {
+    let directions = recipe
+        .patch_average
+        .map(|rule| PatchDirections::new(&bsdf.basis, &rule));
+    prepare_patch_sharing(recipe, bsdf, at, source, directions.as_ref())
+}
+
+/// [`prepare_patch`] with the basis's [`PatchDirections`] made already
+/// (required when the recipe averages over patches, else made here).
+pub fn prepare_patch_sharing(
+    recipe: &Recipe,
+    bsdf: &KlemsBsdf,
+    at: KlemsPatchRef,
+    source: &str,
+    directions: Option<&PatchDirections>,
+) -> Result<Option<PreparedMeasurement>, RecipeError> {
     let Some(measurement) = bsdf.measurement(at.side, at.patch, true) else {
         return Ok(None);
     };
     let mut prepared = recipe.prepare(measurement, source)?;
     if let Some(rule) = recipe.patch_average {
+        let made;
+        let directions = match directions {
+            Some(d) => d,
+            None => {
+                made = PatchDirections::new(&bsdf.basis, &rule);
+                &made
+            }
+        };
         prepared.patch_pairs = Some(Arc::new(patch_pairs(
             &bsdf.basis,
             at.patch,
             &prepared,
             &rule,
+            directions,
         )));
     }
     Ok(Some(prepared))
 }
 
+/// Every direction the pairs of one basis use, made once and shared by
+/// every incidence of a side: per patch, its stratified lights and its
+/// stratified views on each side of the surface.
+#[derive(Debug, Clone)]
+pub struct PatchDirections {
+    table: Arc<Vec<DVec3>>,
+    lights: Vec<std::ops::Range<u32>>,
+    reflected: Vec<std::ops::Range<u32>>,
+    transmitted: Vec<std::ops::Range<u32>>,
+}
+
+impl PatchDirections {
+    /// The directions of `basis`'s patches under `rule`.
+    pub fn new(basis: &KlemsBasis, rule: &PatchAveraging) -> PatchDirections {
+        let mut table = Vec::new();
+        let mut add = |directions: Vec<DVec3>| {
+            let first = table.len() as u32;
+            table.extend(directions);
+            first..table.len() as u32
+        };
+        let patches = basis.patches();
+        let draw = |n: usize, stream: u64, o: usize| {
+            patches[o].stratified_directions(n, &mut Rng::new(rule.seed, stream))
+        };
+        // Incident patch (θ, φ) is the direction of travel: the light is
+        // at φ + 180°.
+        let lights = (0..patches.len())
+            .map(|i| {
+                add(draw(rule.incident_samples, INCIDENT_STREAM + i as u64, i)
+                    .into_iter()
+                    .map(|v| DVec3::new(-v.x, -v.y, v.z))
+                    .collect())
+            })
+            .collect();
+        let views: Vec<Vec<DVec3>> = (0..patches.len())
+            .map(|o| draw(rule.outgoing_samples, o as u64, o))
+            .collect();
+        let reflected = views.iter().map(|v| add(v.clone())).collect();
+        let transmitted = views
+            .iter()
+            .map(|v| add(v.iter().map(|v| DVec3::new(v.x, v.y, -v.z)).collect()))
+            .collect();
+        PatchDirections {
+            table: Arc::new(table),
+            lights,
+            reflected,
+            transmitted,
+        }
+    }
+}
+
 /// The pairs of every sample of `prepared` (file order), incident patch
-/// `incident` of `basis`.
+/// `incident` of `basis`, in `directions` (made for `basis` and `rule`).
 fn patch_pairs(
     basis: &KlemsBasis,
     incident: usize,
     prepared: &PreparedMeasurement,
     rule: &PatchAveraging,
+    directions: &PatchDirections,
 ) -> PatchPairs {
     let light_centre = prepared.measurement.incidence.direction();
     let mirror = DVec3::new(-light_centre.x, -light_centre.y, light_centre.z);
     let near_cosine = rule.near_lobe_deg.to_radians().cos();
-    let lights: Vec<DVec3> = basis
-        .patch(incident)
-        .map(|p| {
-            p.stratified_directions(
-                rule.incident_samples,
-                &mut Rng::new(rule.seed, INCIDENT_STREAM + incident as u64),
-            )
-        })
-        .unwrap_or_default()
-        .into_iter()
-        // Incident patch (θ, φ) is the direction of travel: the light is
-        // at φ + 180°.
-        .map(|v| DVec3::new(-v.x, -v.y, v.z))
-        .collect();
-    let outgoing: Vec<Vec<DVec3>> = basis
-        .patches()
-        .iter()
-        .enumerate()
-        .map(|(o, p)| {
-            p.stratified_directions(rule.outgoing_samples, &mut Rng::new(rule.seed, o as u64))
-        })
-        .collect();
-    // The direction table: the lights, then each sample's views.
-    let n_lights = lights.len() as u32;
-    let mut pairs = PatchPairs::new(lights.clone());
+    let lights = directions.lights.get(incident).cloned().unwrap_or(0..0);
+    let mut pairs = PatchPairs::sharing(Arc::clone(&directions.table));
     for sample in &prepared.measurement.samples {
         let transmitted = sample.theta_deg > 90.0;
         let theta = if transmitted {
@@ -118,7 +171,7 @@ fn patch_pairs(
             sample.theta_deg
         };
         let Some(o) = basis.patch_index(theta, sample.phi_deg) else {
-            pairs.push(std::iter::empty());
+            pairs.push_zip(0..0, 0..0);
             continue;
         };
         let to_side = |v: DVec3| {
@@ -128,22 +181,20 @@ fn patch_pairs(
                 v
             }
         };
-        let first_view = pairs.directions.len() as u32;
-        pairs
-            .directions
-            .extend(outgoing[o].iter().copied().map(to_side));
-        let n_views = pairs.directions.len() as u32 - first_view;
+        let views = if transmitted {
+            directions.transmitted[o].clone()
+        } else {
+            directions.reflected[o].clone()
+        };
         // The lobe's centre for this side: the mirror direction, or the
         // straight-through direction (the mirror's reflection through the
         // surface).
         let lobe = to_side(mirror);
         let near = sample.direction().dot(lobe) >= near_cosine;
         if near || lights.is_empty() {
-            pairs.push(
-                (0..n_lights).flat_map(|l| (first_view..first_view + n_views).map(move |v| (l, v))),
-            );
+            pairs.push_product(lights.clone(), views);
         } else {
-            pairs.push((0..n_views).map(|k| (k % n_lights, first_view + k)));
+            pairs.push_zip(lights.clone(), views);
         }
     }
     pairs

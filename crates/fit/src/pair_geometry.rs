@@ -33,8 +33,15 @@ impl PairGeometry {
         for i in 0..pairs.len() {
             geometry.extend(pairs.of(i).map(|(l, v)| bsdf.geometry(l, v)));
         }
+        let mut ranges = Vec::with_capacity(pairs.len());
+        let mut start = 0;
+        for i in 0..pairs.len() {
+            let end = start + pairs.count(i);
+            ranges.push(start..end);
+            start = end;
+        }
         PairGeometry {
-            ranges: pairs.offsets.windows(2).map(|w| w[0]..w[1]).collect(),
+            ranges,
             geometry: Arc::new(geometry),
         }
     }

@@ -438,6 +438,9 @@ fn read_input(
             }
         };
         let mut inputs = Vec::new();
+        let directions = recipe
+            .patch_average
+            .map(|rule| crate::klems::PatchDirections::new(&bsdf.basis, &rule));
         for patch in 0..bsdf.basis.len() {
             let at = crate::klems::KlemsPatchRef { side, patch };
             let theta = bsdf.basis.patch(patch).map_or(f64::NAN, |p| p.theta_deg);
@@ -445,7 +448,14 @@ fn read_input(
                 continue;
             }
             let label = format!("{source} [{side} patch {patch}]");
-            let Some(mut prepared) = crate::klems::prepare_patch(recipe, &bsdf, at, &label)? else {
+            let Some(mut prepared) = crate::klems::prepare_patch_sharing(
+                recipe,
+                &bsdf,
+                at,
+                &label,
+                directions.as_ref(),
+            )?
+            else {
                 continue;
             };
             prepared.source = label;

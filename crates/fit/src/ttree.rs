@@ -67,13 +67,11 @@ fn leaf_pairs(places: &[TreeSample], finest: f64, seed: u64) -> PatchPairs {
     for (k, place) in places.iter().enumerate() {
         let ratio = place.size / finest;
         let n = ((PAIRS as f64 * ratio * ratio).round() as usize).clamp(PAIRS, MAX_PAIRS);
-        let first = pairs.directions.len() as u32;
         let drawn = place.stratified_pairs(n, &mut Rng::new(seed, k as u64));
         let count = drawn.len() as u32;
-        for (light, view) in drawn {
-            pairs.directions.push(light);
-            pairs.directions.push(view);
-        }
+        let first = pairs
+            .add_directions(drawn.into_iter().flat_map(|(light, view)| [light, view]))
+            .start;
         pairs.push((0..count).map(|j| (first + 2 * j, first + 2 * j + 1)));
     }
     pairs

@@ -162,7 +162,60 @@ impl GeometryBatch {
 impl Extend<Geometry> for GeometryBatch {
     fn extend<I: IntoIterator<Item = Geometry>>(&mut self, iter: I) {
         let iter = iter.into_iter();
-        self.reserve(iter.size_hint().0);
+        let (low, high) = iter.size_hint();
+        if high != Some(low) {
+            self.reserve(low);
+            for g in iter {
+                self.push(g);
+            }
+            return;
+        }
+        // A known length: the columns grow once and are written in place,
+        // without a capacity check per field and pair (a fit that
+        // recomputes patch pairs' geometry on every pass spends most of
+        // its time here).
+        let start = self.len();
+        for column in [
+            &mut self.light_cosine,
+            &mut self.view_cosine,
+            &mut self.lobe_factor,
+            &mut self.x_u,
+            &mut self.x_v,
+            &mut self.cutoff_factor,
+        ] {
+            column.resize(start + low, 0.0);
+        }
+        let rows = self.light_cosine[start..]
+            .iter_mut()
+            .zip(&mut self.view_cosine[start..])
+            .zip(&mut self.lobe_factor[start..])
+            .zip(&mut self.x_u[start..])
+            .zip(&mut self.x_v[start..])
+            .zip(&mut self.cutoff_factor[start..]);
+        let mut iter = iter.peekable();
+        let mut written = 0;
+        for ((((((lc, vc), lf), xu), xv), cf), g) in rows.zip(&mut iter) {
+            *lc = g.light_cosine;
+            *vc = g.view_cosine;
+            *lf = g.lobe_factor;
+            *xu = g.x_u;
+            *xv = g.x_v;
+            *cf = g.cutoff_factor;
+            written += 1;
+        }
+        // An iterator whose length was not what it said.
+        if written < low {
+            for column in [
+                &mut self.light_cosine,
+                &mut self.view_cosine,
+                &mut self.lobe_factor,
+                &mut self.x_u,
+                &mut self.x_v,
+                &mut self.cutoff_factor,
+            ] {
+                column.truncate(start + written);
+            }
+        }
         for g in iter {
             self.push(g);
         }
