@@ -309,7 +309,11 @@ class Klems:
         """One ``Measurement`` per incident patch lit from ``side``
         (``"front"``: light from +z, θ_in ≤ 90°; ``"back"``; ``"both"``):
         the patch averages ``brtf fit`` fits (docs/klems.md, "As measurements")."""
-        return self._data.measurements(side)
+        if side not in ("front", "back", "both"):
+            raise ModelError(f'side={side!r}: expected "front", "back" or "both"')
+        # Light from the front has θ_in ≤ 90°, from the back θ_in > 90°.
+        lit = {"front": lambda t: t <= 90.0, "back": lambda t: t > 90.0, "both": lambda t: True}[side]
+        return [m for m in self._data.measurements() if lit(m.theta_in)]
 
     def xml(self) -> str:
         """The text :meth:`write` writes."""

@@ -185,7 +185,7 @@ def test_messages_are_in_python_terms(alu, klems_fabric, tmp_path):
         (lambda: m.to_klems("quarter", emissivity=(0.9, 0.9), ir_transmittance=0.3), brtf.ExportError,
          "emissivity=0.9 with ir_transmittance=0.3: their sum exceeds 1"),
         (lambda: m.to_klems("eighth"), brtf.ModelError, 'basis="eighth"'),
-        (lambda: brtf.read_klems(klems_fabric).measurements(side="up"), brtf.ModelError, 'side="up"'),
+        (lambda: brtf.read_klems(klems_fabric).measurements(side="up"), brtf.ModelError, "side='up'"),
     ]
     for call, kind, wording in cases:
         with pytest.raises(kind) as e:

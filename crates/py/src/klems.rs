@@ -6,7 +6,7 @@ use crate::errors;
 use crate::fit::to_python;
 use crate::material::{Material, word};
 use crate::measurement::Measurement;
-use brtf_gonio::klems::{BasisSize, KlemsBand, KlemsBsdf, KlemsDirection, Sides, WindowFields};
+use brtf_gonio::klems::{BasisSize, KlemsBand, KlemsBsdf, KlemsDirection, WindowFields};
 use brtf_radiance::export::klems::{KlemsOptions, SolarBand};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
@@ -99,27 +99,16 @@ impl KlemsData {
         Ok(totals.map(|t| t.into_pyarray(py)))
     }
 
-    /// One Measurement per incident patch of `side` (`brtf fit`'s data).
-    #[pyo3(signature = (side = "both"))]
-    fn measurements(&self, py: Python<'_>, side: &str) -> PyResult<Vec<Measurement>> {
-        let sides: Sides = word("side", side)?;
+    /// One Measurement per incident patch and side (`brtf fit`'s data),
+    /// the front's first.
+    fn measurements(&self, py: Python<'_>) -> Vec<Measurement> {
         let source = &self.bsdf.source;
-        let scans = py.detach(|| self.bsdf.to_measurements());
-        let lit_from = |m: &brtf_gonio::Measurement| match sides {
-            Sides::Both => true,
-            // Light from the front has θ_in ≤ 90°, from the back θ_in > 90°.
-            Sides::Front => m.incidence.theta_deg <= 90.0,
-            Sides::Back => m.incidence.theta_deg > 90.0,
-        };
         let measurement = |m: brtf_gonio::Measurement| {
             let (t, p) = (m.incidence.theta_deg, m.incidence.phi_deg);
             Measurement::new(m, None, format!("{source} (θ_in {t}°, φ_in {p}°)"))
         };
-        Ok(scans
-            .into_iter()
-            .filter(lit_from)
-            .map(measurement)
-            .collect())
+        let scans = py.detach(|| self.bsdf.to_measurements());
+        scans.into_iter().map(measurement).collect()
     }
 
     /// The XML text `write` writes: a computed file as `brtf export
