@@ -20,7 +20,6 @@ from ._brtf import (
     Measurement,
     __version__,
     read,
-    read_klems,
 )
 from ._errors import (
     BrtfError,
@@ -31,22 +30,26 @@ from ._errors import (
     MissingFileError,
     ModelError,
 )
-from ._python import fit
+from ._python import En14501, Klems, KlemsBasis, en14501, fit, read_klems
 
 __all__ = [
     "Albedo",
     "BrtfError",
     "ExportError",
     "FileError",
+    "En14501",
     "Fit",
     "FitError",
     "FormatError",
     "IncidenceFit",
+    "Klems",
+    "KlemsBasis",
     "Material",
     "Measurement",
     "MissingFileError",
     "ModelError",
     "__version__",
+    "en14501",
     "fit",
     "read",
     "read_klems",

@@ -43,16 +43,17 @@ def test_read_mpc_file(alu):
 
 
 def test_read_klems(klems_fabric):
-    both = brtf.read_klems(klems_fabric)
-    front = brtf.read_klems(klems_fabric, side="front")
-    back = brtf.read_klems(klems_fabric, side="back")
+    k = brtf.read_klems(klems_fabric)
+    both = k.measurements()
+    front = k.measurements(side="front")
+    back = k.measurements(side="back")
     assert len(front) == 145 and len(back) == 145 and len(both) == 290
     assert all(m.theta_in <= 90 for m in front) and all(m.theta_in > 90 for m in back)
     assert front[0].path is None and len(front[0]) == 290  # reflection + transmission patches
     with pytest.raises(brtf.FitError, match="Klems patch"):
         brtf.fit(front[0])
-    # The file itself is fitted one side at a time (test_fit_of_a_klems_side_equals_the_cli).
-    with pytest.raises(brtf.ModelError, match="one side at a time"):
+    # The file itself is fitted per side (test_fit_of_a_klems_side_equals_the_cli).
+    with pytest.raises(brtf.ModelError, match="fitted per side"):
         brtf.fit(klems_fabric)
 
 
@@ -142,8 +143,8 @@ def test_klems_export_matches_brtf_export(alu_fit, tmp_path, cli):
     assert str(xml) in written
     run_cli(cli, "export", tmp_path / "py", "--klems", "quarter", "--out", tmp_path / "cli")
     # Klems patches read back: 41 incident patches per side in the quarter basis.
-    ours = brtf.read_klems(xml, side="front")
-    theirs = brtf.read_klems(tmp_path / "cli" / "alu-ggx.xml", side="front")
+    ours = brtf.read_klems(xml).measurements(side="front")
+    theirs = brtf.read_klems(tmp_path / "cli" / "alu-ggx.xml").measurements(side="front")
     assert len(ours) == len(theirs) == 41
     for a, b in zip(ours, theirs):
         np.testing.assert_array_equal(a.value, b.value)
@@ -206,7 +207,7 @@ def test_fit_of_a_klems_side_equals_the_cli(cli, klems_fabric, tmp_path):
     assert len(fit.incidences) == len(want["incidences"]) == 9
     for got, ref in zip(fit.incidences, want["incidences"]):
         assert got.material_args == pytest.approx(ref["material_args"], rel=1e-12, abs=1e-15)
-    with pytest.raises(brtf.ModelError, match="one side at a time"):
+    with pytest.raises(brtf.ModelError, match="fitted per side"):
         brtf.fit(klems_fabric, model="trans")
 
 

@@ -74,10 +74,10 @@ def test_wrong_model_name_and_options(alu):
         brtf.Material("metal", rgb=0.5, spec=1.5, roughness=0.1)
     with pytest.raises(brtf.ModelError, match="trans= is needed"):
         brtf.Material("trans", rgb=0.5, spec=0.0, roughness=0.1)
-    with pytest.raises(brtf.ModelError, match="--source-omega"):
+    with pytest.raises(brtf.ModelError, match="source_omega=-1: out of range"):
         brtf.Material("metal", rgb=0.5, source_omega=-1)
     m = brtf.Material("metal", rgb=0.5, spec=0.5, roughness=0.1)
-    with pytest.raises(brtf.ModelError, match="theta-in"):
+    with pytest.raises(brtf.ModelError, match="theta_in=90: out of range"):
         m.eval(90, 0, 30, 180)
     with pytest.raises(ValueError):  # numpy: shapes that do not broadcast
         m.eval(30, 0, np.zeros(3), np.zeros(4))
@@ -130,7 +130,7 @@ def test_directions_out_of_range_raise():
     for theta_out, phi_out in [(float("nan"), 180.0), (-10.0, 180.0), (200.0, 180.0), (30.0, 1e300)]:
         with pytest.raises(brtf.ModelError, match="out of range"):
             m.eval(30.0, 0.0, [10.0, theta_out], phi_out)
-    with pytest.raises(brtf.ModelError, match=r"phi_out 1e300: out of range"):
+    with pytest.raises(brtf.ModelError, match=r"phi_out=1e300: out of range"):
         m.eval(30.0, 0.0, 30.0, 1e300)
     assert m.eval(30.0, 0.0, [0.0, 180.0], [-360.0, 360.0]).shape == (2, 3)
 
@@ -160,3 +160,42 @@ except KeyboardInterrupt:
     assert out.split()[0] == "interrupted", out
     assert after < 1.0, f"{out}: {after:.2f} s after the signal"
     print(f"interrupted {after:.3f} s after SIGINT")
+
+
+def test_messages_are_in_python_terms(alu, klems_fabric, tmp_path):
+    """Errors name keyword arguments and Python calls, never the command
+    line's flags or Rust paths."""
+    m = brtf.Material("plastic", rgb=0.5, spec=0.05, roughness=0.1)
+    cases = [
+        (lambda: m.eval(30.0, 0.0, 200.0, 180.0), brtf.ModelError, "theta_out=200: out of range; allowed: 0 ≤ θ_out ≤ 180"),
+        (lambda: m.eval(90.0, 0.0, 30.0, 180.0), brtf.ModelError, "theta_in=90: out of range"),
+        (lambda: brtf.Material("metal", rgb=0.5, fresnel_k=2.0), brtf.ModelError, "fresnel_k=2: out of range"),
+        (lambda: brtf.fit(alu, model="metal", theta_cap=200), brtf.ModelError, "theta_cap=200: out of range"),
+        (lambda: brtf.fit(alu, model="metal", jobs=100000), brtf.FitError, "jobs=100000: out of range"),
+        (lambda: brtf.fit(alu, model="auto", lobes=2), brtf.FitError, 'model="auto" chooses the lobes itself: leave out lobes='),
+        (lambda: brtf.fit(alu, model="metal", incidences="theta<=10"), brtf.FitError, "incidences= selects"),
+        (lambda: brtf.fit(klems_fabric, model="trans"), brtf.ModelError, 'side="front", "back" or "both"'),
+        (lambda: brtf.read(klems_fabric), brtf.FormatError, "read it with brtf.read_klems"),
+        (lambda: brtf.Material.from_rad("void plastic a\n0\n0\n5 .1 .1 .1 0 0\nvoid metal b\n0\n0\n5 .5 .5 .5 .9 .1\n"),
+         brtf.FormatError, "choose one with name="),
+        (lambda: brtf.en14501(tau_nh=0.1, tau_nn=0.2, rho_nh=0.6), brtf.ModelError, "tau_nn = 0.2 exceeds tau_nh = 0.1"),
+        (lambda: brtf.en14501(tau_nh=1.5, tau_nn=0.2, rho_nh=0.6), brtf.ModelError, "tau_nh = 1.5 is outside 0-1"),
+        (lambda: m.to_klems("quarter", samples=0), brtf.ExportError, "samples 0: out of range"),
+        (lambda: m.to_klems("quarter", conductivity=0.0), brtf.ExportError, "conductivity=0: out of range"),
+        (lambda: m.to_klems("quarter", emissivity=(0.9, 0.9), ir_transmittance=0.3), brtf.ExportError,
+         "emissivity=0.9 with ir_transmittance=0.3: their sum exceeds 1"),
+        (lambda: m.to_klems("eighth"), brtf.ModelError, 'basis="eighth"'),
+        (lambda: brtf.read_klems(klems_fabric).measurements(side="up"), brtf.ModelError, "side='up'"),
+    ]
+    for call, kind, wording in cases:
+        with pytest.raises(kind) as e:
+            call()
+        message = str(e.value)
+        assert wording in message, message
+        assert "--" not in message and "::" not in message, message
+    assert isinstance(e.value, ValueError)
+    # A fit folder that is not brtf's is replaced only with force=True.
+    (tmp_path / "keep.txt").write_text("mine")
+    with pytest.raises(brtf.BrtfError) as e:
+        brtf.fit(alu, model="metal", adequacy=False).save(tmp_path, plots=False)
+    assert "force=True" in str(e.value) and "--" not in str(e.value), str(e.value)

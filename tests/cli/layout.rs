@@ -101,7 +101,9 @@ fn the_front_ends_stay_thin() {
         assert!(*n <= 250, "{} has {n} lines", file.display());
     }
     let py: usize = lines("crates/py/src").iter().map(|(_, n)| n).sum();
-    assert!(py <= 1250, "crates/py/src has {py} lines");
+    // 1250 before the Klems class (klems.rs: its numpy views, to_klems)
+    // and the errors' Python wording (errors.rs), each a thin layer.
+    assert!(py <= 1500, "crates/py/src has {py} lines");
     // Folder staging, export writing and the manifest live in brtf-workflow.
     for (file, _) in cli.iter().chain(&lines("crates/py/src")) {
         let text = std::fs::read_to_string(file).unwrap();

@@ -14,15 +14,79 @@ pub(crate) fn error(
     line: Option<usize>,
 ) -> PyErr {
     Python::attach(|py| {
+        let message = python_terms(&message.into());
         let made = py
             .import("brtf._errors")
             .and_then(|m| m.getattr(class))
-            .and_then(|c| c.call1((message.into(), file, line)));
+            .and_then(|c| c.call1((message, file, line)));
         match made {
             Ok(value) => PyErr::from_value(value),
             Err(e) => e,
         }
     })
+}
+
+/// Phrases of the library's messages that name the command line or Rust,
+/// and their Python terms.
+const PHRASES: [(&str, &str); 10] = [
+    ("brtf_gonio::klems (brtf info reads it)", "brtf.read_klems"),
+    ("--force replaces it", "force=True replaces it"),
+    ("--force to replace it", "force=True to replace it"),
+    ("--free-scale", "free_scale=True"),
+    ("--no-adequacy", "adequacy=False"),
+    ("--model auto", "model=\"auto\""),
+    ("--rho VALUE@THETA", "rho=(VALUE, THETA)"),
+    ("--klems-samples", "samples"),
+    ("--en14501: ", ""),
+    (
+        "sample folders are fitted one job each (fit_samples)",
+        "brtf.fit takes the files of one sample, not a folder",
+    ),
+];
+
+/// `message` in Python's terms: the phrases above, then every other
+/// command-line flag as a keyword, `--theta-in 90:` as `theta_in=90:`.
+pub(crate) fn python_terms(message: &str) -> String {
+    let mut text = message.to_string();
+    for (cli, python) in PHRASES {
+        text = text.replace(cli, python);
+    }
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text.as_str();
+    while let Some(at) = rest.find("--") {
+        out += &rest[..at];
+        let after = &rest[at + 2..];
+        let len = after
+            .find(|c: char| !(c.is_ascii_alphanumeric() || c == '-'))
+            .unwrap_or(after.len());
+        if !after.starts_with(|c: char| c.is_ascii_lowercase()) {
+            out += "--";
+            rest = after;
+            continue;
+        }
+        out += &after[..len].replace('-', "_");
+        rest = &after[len..];
+        // `--flag VALUE`: a value starts with a digit, sign, dot or capital,
+        // or ends with a colon.
+        let value = rest.strip_prefix(' ').filter(|v| {
+            let word = v.split(' ').next().unwrap_or("");
+            word.starts_with(|c: char| c.is_ascii_digit() || "+-.".contains(c) || c.is_uppercase())
+                || word.ends_with(':')
+        });
+        out.push('=');
+        rest = value.unwrap_or(rest);
+    }
+    out + rest
+}
+
+/// A value out of its range, named as the keyword argument it came from.
+pub(crate) fn option(e: brtf_model::OptionError) -> PyErr {
+    let name = e.option.trim_start_matches("--").replace('-', "_");
+    let allowed = e.allowed;
+    model(format!(
+        "{name}={}: out of range; allowed: {allowed}",
+        e.value
+    ))
 }
 
 /// A `brtf.ModelError` (bad argument) with no file.
@@ -88,7 +152,7 @@ pub(crate) fn workflow(e: brtf_workflow::WorkflowError) -> PyErr {
     use brtf_workflow::WorkflowError;
     match e {
         WorkflowError::Usage(message) => error("FitError", message, None, None),
-        WorkflowError::Option(e) => model(e.to_string()),
+        WorkflowError::Option(e) => option(e),
         WorkflowError::Io(e) => {
             let file = Some(e.path.display().to_string());
             error(io_class(&e.source), e.to_string(), file, None)

@@ -85,7 +85,10 @@ impl IncidenceFit {
 }
 
 /// serde → JSON text → Python objects (`json.loads`).
-fn to_python<'py, T: serde::Serialize>(py: Python<'py>, value: &T) -> PyResult<Bound<'py, PyAny>> {
+pub(crate) fn to_python<'py, T: serde::Serialize>(
+    py: Python<'py>,
+    value: &T,
+) -> PyResult<Bound<'py, PyAny>> {
     let text = serde_json::to_string(value).map_err(|e| errors::model(e.to_string()))?;
     py.import("json")?.call_method1("loads", (text,))
 }

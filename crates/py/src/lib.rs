@@ -6,6 +6,7 @@
 
 mod errors;
 mod fit;
+mod klems;
 mod material;
 mod measurement;
 
@@ -15,8 +16,8 @@ use pyo3::prelude::*;
 
 /// Fits a Radiance model to the measurement files `paths`, as `brtf fit`
 /// does: one fit per incidence, one for all, and the θ_in table (`brtf.fit`
-/// turns its `inputs` into the paths). A Klems BSDF XML file is fitted one
-/// side at a time.
+/// turns its `inputs` into the paths). A Klems BSDF XML file is fitted per
+/// side: `side="both"` gives the sides the file holds, each its own fit.
 #[pyfunction(name = "fit")]
 #[pyo3(signature = (paths, model = "metal", *, gray = false, residual = "absolute", loss = "none",
     name = None, variant = "radiance", fresnel_k = None, source_omega = 0.0,
@@ -59,11 +60,11 @@ fn fit_set(
     incidences: Option<String>,
     patch_samples: usize,
     jobs: Option<usize>,
-) -> PyResult<fit::Fit> {
+) -> PyResult<Vec<(Option<&'static str>, fit::Fit)>> {
     use material::word;
     let fresnel_k =
         fresnel_k.map_or(Ok(brtf_model::FRESNEL_K_CLASSIC), material::parse_fresnel_k)?;
-    let side = side.map(|s| word::<Side>("side", &s)).transpose()?;
+    let sides = side.map(|s| word::<Sides>("side", &s)).transpose()?;
     let settings = brtf_workflow::FitSettings {
         gray,
         variant: word("variant", variant)?,
@@ -90,7 +91,7 @@ fn fit_set(
         free_scale,
         interpolation: word("interpolation", interpolation)?,
         adequacy,
-        sides: side.map_or(Sides::Both, Sides::from),
+        sides: sides.unwrap_or_default(),
         incidences: incidences
             .map(|f| {
                 f.parse::<brtf_fit::klems::IncidenceFilter>()
@@ -102,10 +103,10 @@ fn fit_set(
         ..brtf_workflow::FitSettings::new(word::<brtf_fit::ModelChoice>("model", model)?)
     };
     let inputs = FitInputs::classify(&paths).map_err(errors::workflow)?;
-    if inputs.is_klems() != side.is_some() {
-        return Err(errors::model(match side {
+    if inputs.is_klems() != sides.is_some() {
+        return Err(errors::model(match sides {
             Some(_) => "side= chooses the side of a Klems BSDF XML file",
-            None => "a Klems file is fitted one side at a time: side=\"front\" or \"back\"",
+            None => "a Klems file is fitted per side: side=\"front\", \"back\" or \"both\"",
         }));
     }
     // Read and fitted on `jobs` threads, the GIL released; this thread
@@ -116,7 +117,9 @@ fn fit_set(
     let fitted = std::thread::scope(|scope| {
         let worker = scope.spawn(|| -> Result<_, WorkflowError> {
             let job = FitJob::new(&inputs, &settings, name, command_line)?;
-            brtf_workflow::with_jobs(jobs, || job.fit(side, &cancel))?
+            let (sides, _) = job.sides(settings.sides)?;
+            let fit = |side: Option<Side>| Ok((side.map(Side::name), job.fit(side, &cancel)?));
+            brtf_workflow::with_jobs(jobs, || sides.into_iter().map(fit).collect())?
         });
         while !worker.is_finished() {
             py.detach(|| std::thread::sleep(std::time::Duration::from_millis(20)));
@@ -129,8 +132,29 @@ fn fit_set(
         py.detach(|| worker.join())
             .map_err(|_| pyo3::exceptions::PyRuntimeError::new_err("the fit thread panicked"))
     })?;
-    let result = fitted.map_err(errors::workflow)?.result;
-    Ok(fit::Fit::new(result, paths))
+    let fitted: Vec<(Option<&str>, brtf_fit::FittedSet)> = fitted.map_err(errors::workflow)?;
+    let fit =
+        |(side, set): (_, brtf_fit::FittedSet)| (side, fit::Fit::new(set.result, paths.clone()));
+    Ok(fitted.into_iter().map(fit).collect())
+}
+
+/// The `trans` of EN 14501 datasheet values at normal incidence, as the
+/// Radiance text `brtf fit --en14501` prints.
+#[pyfunction]
+fn en14501(
+    tau_nh: f64,
+    tau_nn: f64,
+    rho_nh: f64,
+    spec: f64,
+    name: Option<&str>,
+) -> PyResult<String> {
+    // Through the command line's parser, which checks each value's range.
+    let text = format!("tau_nh={tau_nh},tau_nn={tau_nn},rho_nh={rho_nh},spec={spec}");
+    let values: brtf_fit::en14501::En14501 = text.parse().map_err(errors::model)?;
+    values.trans_args().map_err(errors::model)?;
+    let command_line = ["brtf.en14501 (Python)".to_string()];
+    let rad = brtf_workflow::en14501_material(&values, name, &command_line);
+    rad.map_err(errors::workflow)
 }
 
 /// A fit's progress that only carries the stop request of Ctrl-C (the
@@ -151,7 +175,9 @@ fn _brtf(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<fit::Fit>()?;
     m.add_class::<fit::IncidenceFit>()?;
     m.add_function(wrap_pyfunction!(measurement::read, m)?)?;
-    m.add_function(wrap_pyfunction!(measurement::read_klems, m)?)?;
+    m.add_class::<klems::KlemsData>()?;
+    m.add_function(wrap_pyfunction!(klems::to_klems, m)?)?;
+    m.add_function(wrap_pyfunction!(en14501, m)?)?;
     m.add_function(wrap_pyfunction!(fit_set, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("_FRESNEL_K_CLASSIC", brtf_model::FRESNEL_K_CLASSIC)?;

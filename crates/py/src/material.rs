@@ -92,9 +92,7 @@ fn eval_options(
         flat: !curved,
         source_jitter: 0.0,
     };
-    options
-        .validate()
-        .map_err(|e| errors::model(e.to_string()))?;
+    options.validate().map_err(errors::option)?;
     Ok(options)
 }
 
@@ -216,7 +214,7 @@ fn flat<'py>(
 /// Checks every incidence as `brtf eval` does.
 fn check_incidences(ti: &[f64], pi: &[f64]) -> PyResult<()> {
     for (&t, &p) in ti.iter().zip(pi) {
-        brtf_model::check_incidence(t, p).map_err(|e| errors::model(e.to_string()))?;
+        brtf_model::check_incidence(t, p).map_err(errors::option)?;
     }
     Ok(())
 }
@@ -341,7 +339,7 @@ impl Material {
         );
         check_incidences(ti, pi)?;
         for (&t, &p) in to.iter().zip(po) {
-            brtf_model::check_outgoing(t, p).map_err(|e| errors::model(e.to_string()))?;
+            brtf_model::check_outgoing(t, p).map_err(errors::option)?;
         }
         let mut out = vec![0.0; 3 * to.len()];
         if !to.is_empty() {

@@ -1,9 +1,7 @@
-//! `brtf.Measurement`, `brtf.read`, `brtf.read_klems`.
+//! `brtf.Measurement`, `brtf.read`.
 
 use crate::errors;
-use crate::material::word;
 use brtf_gonio::Measurement as Scan;
-use brtf_gonio::klems::Sides;
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::prelude::*;
@@ -140,32 +138,4 @@ pub(crate) fn read(py: Python<'_>, path: PathBuf) -> PyResult<Measurement> {
         .map_err(errors::read)?;
     let origin = path.display().to_string();
     Ok(py.detach(|| Measurement::new(scan, Some(path), origin)))
-}
-
-/// Reads a Klems BSDF XML file: one Measurement per incident patch and side.
-#[pyfunction]
-#[pyo3(signature = (path, side = "both"))]
-pub(crate) fn read_klems(py: Python<'_>, path: PathBuf, side: &str) -> PyResult<Vec<Measurement>> {
-    let sides: Sides = word("side", side)?;
-    let bsdf = py
-        .detach(|| brtf_gonio::klems::read_path(&path))
-        .map_err(errors::read)?;
-    let origin = path.display().to_string();
-    let scans = py.detach(|| bsdf.to_measurements());
-    Ok(scans
-        .into_iter()
-        // Light from the front has θ_in ≤ 90°, from the back θ_in > 90°.
-        .filter(|m| match sides {
-            Sides::Both => true,
-            Sides::Front => m.incidence.theta_deg <= 90.0,
-            Sides::Back => m.incidence.theta_deg > 90.0,
-        })
-        .map(|m| {
-            let label = format!(
-                "{origin} (θ_in {}°, φ_in {}°)",
-                m.incidence.theta_deg, m.incidence.phi_deg
-            );
-            Measurement::new(m, None, label)
-        })
-        .collect())
 }

@@ -188,6 +188,30 @@ pub fn export_klems_of_material(
     })
 }
 
+/// The Klems BSDF XML of `material`, named `name`, held in memory (the
+/// Python package's `Material.to_klems`): the computation of
+/// [`export_klems_of_material`], with the material's Radiance text standing
+/// for the file (`source` names it) in the provenance.
+pub fn klems_of_composite(
+    material: &brtf_model::Composite,
+    name: &str,
+    eval: &brtf_model::EvalOptions,
+    mut options: KlemsOptions,
+    source: &str,
+) -> Result<KlemsExport, WorkflowError> {
+    eval.validate()?;
+    let primitives = brtf_radiance::composite_primitives(material, name);
+    let text: String = primitives
+        .iter()
+        .map(brtf_radiance::format_primitive)
+        .collect();
+    options.name = name.to_string();
+    let sha = brtf_io::sha256_hex(text.as_bytes());
+    Ok(klems::klems_from_composite(
+        material, eval, source, &sha, &options,
+    )?)
+}
+
 /// `brtf check`: renders the fit folder `dir` through the virtual
 /// gonio-photometer ([`brtf_trace::check_fit`]) and writes the comparison
 /// as CSV to `out` (default `DIR/check.csv`). Returns the report and the

@@ -33,7 +33,7 @@ mod settings;
 
 pub use amend::{
     Amended, check_folder, ensure_fit_json, export_into, export_klems_of_material,
-    klems_of_fit_folder, plot_folder, read_fit, write_klems_into,
+    klems_of_composite, klems_of_fit_folder, plot_folder, read_fit, write_klems_into,
 };
 pub use directions::{ThetaGrid, parse_direction_line, parse_numbers};
 pub use en14501::en14501_material;

@@ -61,6 +61,28 @@ impl FitJob {
         &self.files
     }
 
+    /// The sides a fit of `sides` takes, with a note when a Klems file
+    /// asked for both holds one side only (genBSDF writes one): that side.
+    /// Gonio files have no side: `[None]`.
+    pub fn sides(&self, sides: Sides) -> Result<(Vec<Option<Side>>, Vec<String>), WorkflowError> {
+        if !self.klems {
+            return Ok((vec![None], Vec::new()));
+        }
+        let mut wanted = sides.sides();
+        let mut notes = Vec::new();
+        if sides == Sides::Both {
+            let present = crate::inputs::klems_sides(&self.files)?;
+            if let [only] = present[..] {
+                wanted = vec![only];
+                notes.push(format!(
+                    "note: the BSDF XML file holds the {only} side only (light from {}): that side is fitted",
+                    if only == Side::Front { "+z" } else { "−z" }
+                ));
+            }
+        }
+        Ok((wanted.into_iter().map(Some).collect(), notes))
+    }
+
     /// Fits the files (of Klems XML, the incident patches of `side`).
     pub fn fit(
         &self,
@@ -123,24 +145,7 @@ pub fn fit_to_folder(
         .clone()
         .unwrap_or_else(|| Path::new("fits").join(job.name()));
     let update = FolderUpdate::fresh(&out)?;
-    let mut notes = Vec::new();
-    let sides: Vec<Option<Side>> = if job.klems {
-        let mut wanted = sides.sides();
-        // Both by default: the sides the file has (genBSDF writes one).
-        if sides == Sides::Both {
-            let present = crate::inputs::klems_sides(&job.files)?;
-            if let [only] = present[..] {
-                wanted = vec![only];
-                notes.push(format!(
-                    "note: the BSDF XML file holds the {only} side only (light from {}): that side is fitted",
-                    if only == Side::Front { "+z" } else { "−z" }
-                ));
-            }
-        }
-        wanted.into_iter().map(Some).collect()
-    } else {
-        vec![None]
-    };
+    let (sides, notes) = job.sides(sides)?;
     let nested = sides.len() > 1;
     if nested {
         check_two_sided_replaceable(update.target(), &job.files, request.force)?;

@@ -275,6 +275,69 @@ pub fn to_klems_xml(
     Ok(o)
 }
 
+impl super::KlemsBsdf {
+    /// The file as the writer writes it ([`to_klems_xml`]): every matrix
+    /// in file order, the header's `Material` fields, `comment` leading.
+    /// The writer has room for the header's thermal fields only
+    /// ([`WindowFields`]); a missing or unreadable thickness is written as
+    /// 1 mm (`brtf export`'s default). Both are said in the comment.
+    pub fn to_xml(&self, mut comment: Vec<String>) -> Result<String, String> {
+        let h = &self.header;
+        let mut window = WindowFields::default();
+        let mut front_back = [None, None];
+        let mut dropped = Vec::new();
+        for (key, value) in &h.other {
+            let number = value.trim().parse::<f64>().ok().filter(|v| v.is_finite());
+            match (key.as_str(), number) {
+                ("ThermalConductivity", Some(v)) => window.conductivity = Some(v),
+                ("EmissivityFront", Some(v)) => front_back[0] = Some(v),
+                ("EmissivityBack", Some(v)) => front_back[1] = Some(v),
+                ("TIR", Some(v)) => window.ir_transmittance = Some(v),
+                ("PermeabilityFactor", Some(v)) => window.permeability = Some(v),
+                _ => dropped.push(format!("{key} {value}")),
+            }
+        }
+        if let [Some(front), Some(back)] = front_back {
+            window.emissivity = Some([front, back]);
+        } else {
+            let one = front_back.iter().zip(["EmissivityFront", "EmissivityBack"]);
+            dropped.extend(one.filter_map(|(v, k)| v.map(|v| format!("{k} {v} (alone)"))));
+        }
+        if !dropped.is_empty() {
+            comment.push(format!(
+                "Material fields of {} not written: {}.",
+                self.source,
+                dropped.join(", ")
+            ));
+        }
+        let thickness_mm = h.thickness_mm().unwrap_or_else(|| {
+            comment.push(format!(
+                "{}: no thickness in millimetres; written as 1 mm.",
+                self.source
+            ));
+            1.0
+        });
+        let header = KlemsWriteHeader {
+            name: h.name.clone().unwrap_or_default(),
+            manufacturer: h.manufacturer.clone().unwrap_or_default(),
+            thickness_mm,
+            device_type: h.device_type.clone().unwrap_or_else(|| "Other".into()),
+            window,
+            comment,
+        };
+        let blocks: Vec<KlemsWriteBlock> = self
+            .matrices
+            .iter()
+            .map(|m| KlemsWriteBlock {
+                band: m.band.clone(),
+                direction: m.direction,
+                values: m.values.clone(),
+            })
+            .collect();
+        to_klems_xml(&header, &self.basis, &blocks)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -373,6 +436,9 @@ mod tests {
         for (a, b) in m.values.iter().zip(&values) {
             assert!((a - b).abs() <= 1e-5 * b, "{a} {b}");
         }
+        // Written again from what was read: the same file, comment aside.
+        let again = read.to_xml(vec!["made -- by a test".into()]).unwrap();
+        assert_eq!(again, text);
         let mut short = blocks[0].clone();
         short.values.pop();
         assert!(to_klems_xml(&header, &basis, &[short]).is_err());
