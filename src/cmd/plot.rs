@@ -21,6 +21,9 @@ pub(crate) struct PlotArgs {
     /// Largest angle between a sample and the plane of incidence in the cuts, degrees [default: automatic].
     #[arg(long)]
     pub plane_tolerance: Option<f64>,
+    /// Draw each incidence's map and cut also for patch-averaged data (Klems, tensor trees), where they are left out by default.
+    #[arg(long)]
+    pub incidence_charts: bool,
 }
 
 pub(crate) fn run(args: PlotArgs) -> Result<()> {
@@ -41,6 +44,7 @@ pub(crate) fn run(args: PlotArgs) -> Result<()> {
         search_dirs: args.search_dirs,
         ratio: args.ratio,
         plane_tolerance_deg: args.plane_tolerance,
+        incidence_charts: args.incidence_charts.then_some(true),
     };
     let written = brtf_workflow::plot_folder(&args.dir, options)?;
     for w in &written.warnings {

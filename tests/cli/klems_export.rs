@@ -586,8 +586,25 @@ fn anisotropic_fit_exports_the_parameters_of_each_azimuth() {
     );
     // At each fitted incidence the table gives that incidence's own fit.
     let result = brtf_fit::FitResult::read(&fit_dir).unwrap();
-    // So many incidences' maps and cuts load when scrolled to, and the 3D
-    // view holds every incidence behind one picker.
+    // Patch-averaged data: no map or cut per incidence unless asked for,
+    // and the report says how to get them.
+    assert_eq!(report.matches("loading=\"lazy\"").count(), 0);
+    assert!(report.contains("--incidence-charts"), "the report says how");
+    let maps = |dir: &Path| {
+        std::fs::read_dir(dir.join("plots"))
+            .unwrap()
+            .filter(|e| {
+                let name = e.as_ref().unwrap().file_name();
+                name.to_string_lossy().starts_with("map-")
+            })
+            .count()
+    };
+    assert_eq!(maps(&fit_dir), 0);
+    // Asked for, so many incidences' maps and cuts load when scrolled to,
+    // and the 3D view holds every incidence behind one picker.
+    brtf(&["plot", s(&fit_dir), "--incidence-charts"], "").ok();
+    let report = std::fs::read_to_string(fit_dir.join("report.html")).unwrap();
+    assert_eq!(maps(&fit_dir), 2 * result.incidences.len());
     assert_eq!(
         report.matches("loading=\"lazy\"").count(),
         2 * result.incidences.len()

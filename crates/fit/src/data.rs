@@ -360,18 +360,20 @@ impl PatchPairs {
         out
     }
 
-    /// The BSDF of sample `i` averaged over its pairs.
+    /// The BSDF of sample `i` averaged over its pairs, summed in
+    /// brtf-model's vectorised kernel as the fitter sums it.
     pub fn average(&self, bsdf: &brtf_model::Bsdf, i: usize) -> [f64; 3] {
-        let pairs = self.of(i);
-        let n = pairs.len().max(1) as f64;
-        let mut sum = [0.0; 3];
-        for (l, v) in pairs {
-            let f = bsdf.eval(l, v);
-            for (s, x) in sum.iter_mut().zip(f) {
-                *s += x;
-            }
+        thread_local! {
+            static SCRATCH: std::cell::RefCell<brtf_model::GeometryBatch> =
+                std::cell::RefCell::new(brtf_model::GeometryBatch::new());
         }
-        sum.map(|s| s / n)
+        SCRATCH.with_borrow_mut(|scratch| {
+            scratch.clear();
+            scratch.extend(self.of(i).map(|(l, v)| bsdf.geometry(l, v)));
+            let n = scratch.len();
+            let inverse = 1.0 / n.max(1) as f64;
+            bsdf.sum_geometry::<3>(scratch, 0..n).map(|s| s * inverse)
+        })
     }
 }
 

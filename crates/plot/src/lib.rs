@@ -92,6 +92,11 @@ pub struct PlotOptions {
     /// for the cuts; `None` picks the smallest of 0.25–3° that gives 60
     /// fitted samples.
     pub plane_tolerance_deg: Option<f64>,
+    /// Draw each incidence's map and cut: `None` draws them except for
+    /// patch-averaged data (a Klems side's 145 incidences would give 290
+    /// charts, most of the run's time and memory; its report's 3D view
+    /// shows every incidence).
+    pub incidence_charts: Option<bool>,
 }
 
 /// What [`write_plots`] wrote.
@@ -348,11 +353,19 @@ fn plot(
     // the selection: they are made while the incidences are built (the
     // model beside every sample). Nothing here is made on first use, so
     // no thread waits for another's lazy value inside the joins.
+    // A Klems side's maps and cuts are drawn on request only.
+    let incidence_charts = options
+        .incidence_charts
+        .unwrap_or(result.recipe.patch_average.is_none());
     let (loaded, grids): (Vec<Result<Incidence, String>>, Vec<_>) = rayon::join(
         || load_all(dir, result, prepared, options),
         || {
+            // Without maps, only the hemispherical integrals read the
+            // grids: each is made there and dropped.
+            let wanted = if incidence_charts { prepared.len() } else { 0 };
             prepared
                 .par_iter()
+                .take(wanted)
                 .take(result.incidences.len())
                 .map(prepare::grids_of_prepared)
                 .collect()
@@ -398,7 +411,7 @@ fn plot(
     let model = result.config.shape().label();
 
     let mut jobs: Vec<Job> = Vec::new();
-    for inc in &incs {
+    for inc in incs.iter().filter(|_| incidence_charts) {
         let report = &result.incidences[inc.index];
         let label = charts::incidence_label(inc.theta_in, inc.phi_in);
         let mut map = MapChart::new(inc, String::new(), ratio, report.rms_rel);
@@ -447,7 +460,7 @@ fn plot(
         .map(|((report, l), tag)| {
             let data = l.as_ref().map_err(String::as_str);
             let charts = match data {
-                Ok(inc) => {
+                Ok(inc) if incidence_charts => {
                     let map = MapChart::new(inc, String::new(), ratio, report.rms_rel);
                     let cut = CutChart {
                         inc,
@@ -459,7 +472,7 @@ fn plot(
                         (cut.name(), cut.size(), "cut through the plane of incidence"),
                     ]
                 }
-                Err(_) => Vec::new(),
+                _ => Vec::new(),
             };
             report::IncidenceEntry {
                 report,
@@ -477,6 +490,15 @@ fn plot(
         warnings: &warnings,
         ratio,
         view: viewer::html(result, &incs, ratio, "view3d-viewer"),
+        no_incidence_charts: (!incidence_charts).then(|| {
+            format!(
+                "Each incidence's map and cut are not drawn for patch-averaged data ({} \
+                 incidences): the 3D view above shows every incidence; `brtf plot {} \
+                 --incidence-charts` draws them.",
+                result.incidences.len(),
+                dir.display()
+            )
+        }),
     });
     // The report is written with the plots' files, once they all rendered.
     let report_path = dir.join("report.html");
@@ -490,9 +512,10 @@ fn plot(
             }
         })
     };
-    let made = incs
-        .iter()
-        .all(|inc| wanted(inc).into_iter().all(|h| inc.has_grid(h)));
+    let made = !incidence_charts
+        || incs
+            .iter()
+            .all(|inc| wanted(inc).into_iter().all(|h| inc.has_grid(h)));
     let files = render_and_write(
         &jobs,
         &plots,

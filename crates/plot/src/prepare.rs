@@ -135,6 +135,30 @@ impl Incidence {
         })
     }
 
+    /// The grid the hemispherical integrals sum over: the maps' grid for
+    /// measured scans; for patch-averaged data (a few hundred patches,
+    /// each many pixels wide) a 128² grid made for the caller alone and
+    /// not kept, the same whether the maps are drawn or not (a Klems
+    /// side's 512² grids took seconds and hundreds of MB).
+    pub(crate) fn integration_grid(
+        &self,
+        hemisphere: Hemisphere,
+        patch_averaged: bool,
+    ) -> std::borrow::Cow<'_, Coverage> {
+        if !patch_averaged {
+            return std::borrow::Cow::Borrowed(self.coverage(hemisphere));
+        }
+        std::borrow::Cow::Owned(disk_grid_of_size(
+            hemisphere,
+            self.samples.len(),
+            disk::COVERAGE_SIZE / 4,
+            |k| {
+                let s = &self.samples[k];
+                (s.theta, s.dir, s.used(), s.data)
+            },
+        ))
+    }
+
     /// The grid of `hemisphere` is made.
     pub(crate) fn has_grid(&self, hemisphere: Hemisphere) -> bool {
         let slot = match hemisphere {
@@ -323,6 +347,16 @@ fn disk_grid(
     n: usize,
     sample: impl Fn(usize) -> (f64, DVec3, bool, f64) + Sync,
 ) -> Coverage {
+    disk_grid_of_size(hemisphere, n, disk::COVERAGE_SIZE, sample)
+}
+
+/// [`disk_grid`] of `size` pixels a side.
+fn disk_grid_of_size(
+    hemisphere: Hemisphere,
+    n: usize,
+    size: u32,
+    sample: impl Fn(usize) -> (f64, DVec3, bool, f64) + Sync,
+) -> Coverage {
     // In pieces of their own, then joined once into vectors of the exact
     // size (no growing, no list of partial vectors).
     const PIECE: usize = 8192;
@@ -353,12 +387,7 @@ fn disk_grid(
         ids.extend_from_slice(i);
         points.extend_from_slice(p);
     }
-    Coverage::new(
-        &points,
-        &ids,
-        disk::COVERAGE_SIZE,
-        disk::radius_of(disk::FILL_DEG),
-    )
+    Coverage::new(&points, &ids, size, disk::radius_of(disk::FILL_DEG))
 }
 
 /// The model value the fit compares with sample `index` of `prepared`

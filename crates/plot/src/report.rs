@@ -43,6 +43,8 @@ pub(crate) struct ReportInput<'a> {
     pub ratio: f64,
     /// The 3D view ([`crate::viewer::html`]).
     pub view: String,
+    /// Why each incidence's map and cut are not drawn, when they are not.
+    pub no_incidence_charts: Option<String>,
 }
 
 /// HTML-escapes text.
@@ -609,6 +611,9 @@ pub(crate) fn html(input: &ReportInput) -> String {
         fmt(input.ratio),
         fmt(input.ratio)
     );
+    if let Some(why) = &input.no_incidence_charts {
+        let _ = writeln!(out, "<p>{}</p>", esc(why));
+    }
     for entry in &input.incidences {
         let r = entry.report;
         let label = incidence_label(r.theta_in, r.phi_in);
@@ -647,6 +652,9 @@ pub(crate) fn html(input: &ReportInput) -> String {
             Ok(inc) => {
                 for w in &inc.warnings {
                     let _ = writeln!(out, "<p class=\"warn\">{}</p>", esc(w));
+                }
+                if entry.charts.is_empty() {
+                    continue;
                 }
                 out.push_str("<div class=\"pair\">\n");
                 for (stem, size, what) in &entry.charts {

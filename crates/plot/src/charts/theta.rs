@@ -24,6 +24,7 @@ use brtf_model::{Composite, CompositeBsdf};
 use plotters::coord::types::RangedCoordf64;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
+use rayon::prelude::*;
 use std::sync::OnceLock;
 
 /// Points along θ_in for the interpolation and all-incidence curves.
@@ -86,9 +87,12 @@ pub(crate) struct Integrals {
 
 /// The integrals of every incidence; `incs[k]` is incidence k's data, if read.
 pub(crate) fn integrals(result: &FitResult, incs: &[Option<&Incidence>]) -> Vec<Integrals> {
+    // In parallel: each incidence's model integral and a patch-averaged
+    // incidence's grids take milliseconds.
+    let patch_averaged = result.recipe.patch_average.is_some();
     result
         .incidences
-        .iter()
+        .par_iter()
         .zip(incs)
         .map(|(report, inc)| {
             let channels = inc.map_or(1, |i| i.channels);
@@ -110,7 +114,7 @@ pub(crate) fn integrals(result: &FitResult, incs: &[Option<&Incidence>]) -> Vec<
                     if !used.contains(hemisphere) {
                         continue;
                     }
-                    let coverage = inc.coverage(*hemisphere);
+                    let coverage = inc.integration_grid(*hemisphere, patch_averaged);
                     let (mut d, mut m) = (0.0, 0.0);
                     for j in 0..coverage.size {
                         for i in 0..coverage.size {
