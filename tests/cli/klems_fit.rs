@@ -526,3 +526,65 @@ fn a_one_sided_file_fits_its_side_and_is_named_after_the_file() {
     assert!(out.join("cl_Tn0.33.rad").is_file());
     assert!(!out.join("front").exists() && !out.join("back").exists());
 }
+
+/// A static material whose ρ_dh or τ_dh is more than 10 % off the data's
+/// at some incidence is written as `<name>-energy-off.rad`, says so in its
+/// first line and in a note, and the preview scene names that file; the
+/// θ_in-dependent material keeps its name. SA1's transmittance falls from
+/// 0.16 to 0.01 over θ_in, which one `trans` cannot follow.
+#[test]
+fn a_static_material_whose_energy_is_off_is_written_under_a_name_that_says_so() {
+    let tmp = temp_dir();
+    let out = tmp.path().join("sa1");
+    let run = brtf(
+        &[
+            "fit",
+            s(&fabric("2011-SA1.xml")),
+            "--model",
+            "trans",
+            "--gray",
+            "--side",
+            "front",
+            "--no-plots",
+            "--out",
+            s(&out),
+        ],
+        "",
+    );
+    assert!(run.success, "{run:?}");
+    let printed = format!("{}{}", run.stdout, run.stderr);
+    let name = "Satine_5500_5___White_Pearl";
+    let off = out.join(format!("{name}-energy-off.rad"));
+    assert!(off.exists(), "{printed}");
+    assert!(!out.join(format!("{name}.rad")).exists());
+    assert!(out.join(format!("{name}-theta.rad")).exists());
+    let text = std::fs::read_to_string(&off).unwrap();
+    let first = text.lines().next().unwrap();
+    assert!(
+        first.starts_with("# ENERGY OFF: it transmits") && first.contains("tau_dh"),
+        "{first}"
+    );
+    assert!(
+        printed.contains(&format!(
+            "{name}-energy-off.rad: written under this name, not {name}.rad"
+        )),
+        "{printed}"
+    );
+    let preview = std::fs::read_to_string(out.join(format!("{name}-preview.rad"))).unwrap();
+    assert!(preview.contains(&format!("oconv {name}-energy-off.rad ")));
+    // The check's figures are the fit's: the worst incidence's data τ_dh
+    // in the first line is the one fit.json holds.
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("fit.json")).unwrap()).unwrap();
+    let grazing = json["incidences"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|r| r["theta_in"].as_f64().unwrap() > 80.0)
+        .map(|r| r["adequacy"]["tau_data"].as_f64().unwrap())
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        first.contains(&format!("{grazing:.3}")),
+        "{first} vs {grazing}"
+    );
+}

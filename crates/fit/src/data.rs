@@ -160,30 +160,71 @@ impl SamplePairs {
             SamplePairs::Listed { start, end } => end - start,
         }
     }
+}
 
-    /// Pair `k`'s (light, view) indices; listed pairs read `lights` and
-    /// `views`.
+/// The pairs of one sample in order, with running indices (a pass over
+/// every pair of a Klems side takes them one by one: no division per
+/// pair).
+struct PairIter<'a> {
+    pairs: &'a PatchPairs,
+    sample: SamplePairs,
+    k: usize,
+    n: usize,
+    /// The light's and the view's place in their ranges.
+    light: usize,
+    step: usize,
+    view: usize,
+}
+
+impl Iterator for PairIter<'_> {
+    type Item = (DVec3, DVec3);
+
     #[inline]
-    fn pair(&self, k: usize, lights: &[u32], views: &[u32]) -> (usize, usize) {
-        match *self {
-            SamplePairs::Product { lights, views } => {
-                let n = views.len as usize;
-                (lights.start as usize + k / n, views.start as usize + k % n)
-            }
-            SamplePairs::Zip { lights, views } => (
-                lights.start as usize + k % lights.len as usize,
-                views.start as usize + k,
-            ),
-            SamplePairs::Shuffled { lights, views } => (
-                lights.start as usize + (k * 7 + 3) % lights.len as usize,
-                views.start as usize + k,
-            ),
-            SamplePairs::Listed { start, .. } => {
-                (lights[start + k] as usize, views[start + k] as usize)
-            }
+    fn next(&mut self) -> Option<(DVec3, DVec3)> {
+        if self.k >= self.n {
+            return None;
         }
+        let directions = &self.pairs.directions;
+        let item = match self.sample {
+            SamplePairs::Product { lights, views } => {
+                let item = (
+                    directions[lights.start as usize + self.light],
+                    directions[views.start as usize + self.view],
+                );
+                self.view += 1;
+                if self.view == views.len as usize {
+                    self.view = 0;
+                    self.light += 1;
+                }
+                item
+            }
+            SamplePairs::Zip { lights, views } | SamplePairs::Shuffled { lights, views } => {
+                let item = (
+                    directions[lights.start as usize + self.light],
+                    directions[views.start as usize + self.k],
+                );
+                self.light += self.step;
+                while self.light >= lights.len as usize {
+                    self.light -= lights.len as usize;
+                }
+                item
+            }
+            SamplePairs::Listed { start, .. } => (
+                directions[self.pairs.listed_lights[start + self.k] as usize],
+                directions[self.pairs.listed_views[start + self.k] as usize],
+            ),
+        };
+        self.k += 1;
+        Some(item)
+    }
+
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        let left = self.n - self.k;
+        (left, Some(left))
     }
 }
+
+impl ExactSizeIterator for PairIter<'_> {}
 
 /// Most pairs per sample in [`PatchPairs::coarse`].
 const COARSE_PAIRS: usize = 32;
@@ -307,10 +348,19 @@ impl PatchPairs {
     #[inline]
     pub fn of(&self, i: usize) -> impl ExactSizeIterator<Item = (DVec3, DVec3)> + '_ {
         let sample = self.samples[i];
-        (0..sample.count()).map(move |k| {
-            let (l, v) = sample.pair(k, &self.listed_lights, &self.listed_views);
-            (self.directions[l], self.directions[v])
-        })
+        let (light, step) = match sample {
+            SamplePairs::Shuffled { lights, .. } => (3 % lights.len.max(1) as usize, 7),
+            _ => (0, 1),
+        };
+        PairIter {
+            pairs: self,
+            sample,
+            k: 0,
+            n: sample.count(),
+            light,
+            step,
+            view: 0,
+        }
     }
 
     /// The pairs of the samples `indices`, in that order.
@@ -406,5 +456,59 @@ impl IncidenceData {
             Some(pairs) => pairs.average(bsdf, i),
             None => bsdf.eval(self.light(), self.samples[i].view),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Direction i of the table is (i, 0, 1): a pair's vectors give back
+    /// their indices.
+    fn table(n: usize) -> Vec<DVec3> {
+        (0..n).map(|i| DVec3::new(i as f64, 0.0, 1.0)).collect()
+    }
+
+    fn indices(pairs: &PatchPairs, i: usize) -> Vec<(usize, usize)> {
+        pairs
+            .of(i)
+            .map(|(l, v)| (l.x as usize, v.x as usize))
+            .collect()
+    }
+
+    /// Each pattern yields exactly the pairs it describes, in order, and
+    /// selections and the coarse stand-in share the direction table.
+    #[test]
+    fn patterns_yield_their_pairs() {
+        let mut pairs = PatchPairs::new(table(12));
+        pairs.push_product(0..3, 5..9);
+        pairs.push_zip(0..3, 5..10);
+        pairs.push((0..4).map(|k| (11 - k, k)));
+        pairs.push_zip(0..0, 5..9);
+        let product: Vec<_> = (0..3).flat_map(|l| (5..9).map(move |v| (l, v))).collect();
+        let zip: Vec<_> = (0..5).map(|k| (k % 3, 5 + k)).collect();
+        let listed: Vec<_> = (0..4).map(|k| (11 - k, k)).collect();
+        assert_eq!(indices(&pairs, 0), product);
+        assert_eq!(indices(&pairs, 1), zip);
+        assert_eq!(indices(&pairs, 2), listed);
+        assert!(indices(&pairs, 3).is_empty(), "no light, no pair");
+        assert_eq!(pairs.pair_count(), 12 + 5 + 4);
+        assert_eq!(pairs.of(0).len(), 12);
+
+        let selected = pairs.select([2, 0]);
+        assert_eq!(indices(&selected, 0), listed);
+        assert_eq!(indices(&selected, 1), product);
+        assert!(Arc::ptr_eq(&selected.directions, &pairs.directions));
+
+        // A product becomes each view with a shuffled light; zips stay;
+        // listed pairs are thinned to at most COARSE_PAIRS.
+        let coarse = pairs.coarse();
+        let shuffled: Vec<_> = (0..4).map(|k| ((k * 7 + 3) % 3, 5 + k)).collect();
+        assert_eq!(indices(&coarse, 0), shuffled);
+        assert_eq!(indices(&coarse, 1), zip);
+        assert_eq!(indices(&coarse, 2), listed);
+        let mut many = PatchPairs::new(table(2));
+        many.push((0..100).map(|_| (0, 1)));
+        assert_eq!(many.coarse().count(0), 25);
     }
 }

@@ -377,8 +377,9 @@ fn fit_many(
         if coarse_blocks.is_none() || !approximate.cost.is_finite() {
             return approximate;
         }
-        // From the coarse pairs' minimum, a few passes over every pair.
-        let mut exact = solver.solve(&blocks, approximate.u, Stage::FINAL);
+        // From the coarse pairs' minimum, a few passes over every pair
+        // (extrapolated too: the linear convergence is the model's).
+        let mut exact = solver.solve_final(&blocks, approximate.u);
         exact.evaluations += approximate.evaluations;
         exact
     };

@@ -13,6 +13,7 @@
 //! renamed into place). `docs/radiance.md` explains how to use the files.
 
 mod cal;
+mod energy;
 pub mod klems;
 pub mod klems_cal;
 mod num;
@@ -24,6 +25,7 @@ mod theta;
 
 use brtf_fit::{FitReport, FitResult};
 use brtf_model::{Composite, MaterialKind, ModelError};
+pub use energy::{EnergyOff, STATIC_ENERGY_TOLERANCE};
 use std::path::{Path, PathBuf};
 
 /// What to export.
@@ -166,6 +168,12 @@ pub fn preview_file_name(name: &str) -> String {
     format!("{name}-preview.rad")
 }
 
+/// File name of a static material whose energy is off (see
+/// [`STATIC_ENERGY_TOLERANCE`]).
+pub fn energy_off_file_name(name: &str) -> String {
+    format!("{name}-energy-off.rad")
+}
+
 /// Builds every export of `result` in memory.
 pub fn exports(result: &FitResult, options: &ExportOptions) -> Result<Export, ExportError> {
     let coloured;
@@ -178,6 +186,11 @@ pub fn exports(result: &FitResult, options: &ExportOptions) -> Result<Export, Ex
     };
     let name = material_name(result, options)?;
     let chosen = static_material::choose(result, options.at)?;
+    let energy = energy::static_energy_off(result, &chosen.material);
+    let static_file = match &energy {
+        Some(_) => energy_off_file_name(&name),
+        None => static_file_name(&name),
+    };
     let mut files = Vec::new();
     let mut notes = Vec::new();
     let theta = match (&result.table, options.theta_dependent) {
@@ -189,7 +202,13 @@ pub fn exports(result: &FitResult, options: &ExportOptions) -> Result<Export, Ex
             );
             None
         }
-        (Some(table), true) => Some(theta::build(result, table, &name, options.colour)?),
+        (Some(table), true) => Some(theta::build(
+            result,
+            table,
+            &name,
+            &static_file,
+            options.colour,
+        )?),
         (None, true) => {
             notes.push(format!(
                 "no θ_in-dependent material: the fit has {} incidence(s), interpolation needs two",
@@ -199,10 +218,30 @@ pub fn exports(result: &FitResult, options: &ExportOptions) -> Result<Export, Ex
         }
         (_, false) => None,
     };
-    let stat = static_material::text(result, &chosen, &name, theta.is_some(), options.colour);
+    let mut stat = static_material::text(
+        result,
+        &chosen,
+        &name,
+        &static_file,
+        theta.is_some(),
+        options.colour,
+    );
+    if let Some(off) = &energy {
+        let what = energy_off_text(off);
+        let instead = if theta.is_some() {
+            format!("; {} follows each incidence", theta_file_name(&name))
+        } else {
+            String::new()
+        };
+        notes.push(format!(
+            "{static_file}: written under this name, not {}, because {what}{instead}",
+            static_file_name(&name)
+        ));
+        stat.text = format!("# ENERGY OFF: {}.\n{}", report::ascii(&what), stat.text);
+    }
     notes.extend(stat.notes);
     files.push(ExportFile {
-        file_name: static_file_name(&name),
+        file_name: static_file,
         text: stat.text,
     });
     if let Some(theta) = theta {
@@ -225,10 +264,32 @@ pub fn exports(result: &FitResult, options: &ExportOptions) -> Result<Export, Ex
     } else if options.preview {
         files.push(ExportFile {
             file_name: preview_file_name(&name),
-            text: preview::text(result, &name, files.len() > 1),
+            text: preview::text(result, &name, &files[0].file_name, files.len() > 1),
         });
     }
     Ok(Export { name, files, notes })
+}
+
+/// Why a static material's file is renamed, in words.
+fn energy_off_text(off: &energy::EnergyOff) -> String {
+    let (quantity, side) = match off.label {
+        "rho_dh" => ("ρ_dh", "reflects"),
+        _ => ("τ_dh", "transmits"),
+    };
+    let more = if off.deviation() > 0.0 {
+        "more"
+    } else {
+        "less"
+    };
+    format!(
+        "it {side} {:.0}% {more} than the sample at θ_in = {}° ({quantity} {:.3} against the \
+         data's {:.3}; beyond {:.0}%)",
+        100.0 * off.deviation().abs(),
+        num::sig(off.theta_in, 4),
+        off.model,
+        off.data,
+        100.0 * STATIC_ENERGY_TOLERANCE
+    )
 }
 
 /// Writes every export of `result` into `dir` (which must exist), each file

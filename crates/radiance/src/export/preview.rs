@@ -18,7 +18,7 @@ const SUN_DIRECTION: [f64; 3] = [FRAC_1_SQRT_2, 0.0, FRAC_1_SQRT_2];
 const SKY_RADIANCE: f64 = 0.3;
 
 /// The scene text.
-pub(crate) fn text(result: &FitResult, name: &str, with_theta: bool) -> String {
+pub(crate) fn text(result: &FitResult, name: &str, static_file: &str, with_theta: bool) -> String {
     let stem = format!("{name}-preview");
     let omega = 2.0 * PI * (1.0 - (0.5 * SUN_APEX_DEG.to_radians()).cos());
     // Normal irradiance π, so a white Lambertian floor facing the sun has radiance 1.
@@ -36,7 +36,7 @@ pub(crate) fn text(result: &FitResult, name: &str, with_theta: bool) -> String {
         "the camera's right and a dim uniform sky. The material is not in this file: give".into(),
         "oconv one of the material files first. In this folder:".into(),
         String::new(),
-        format!("  oconv {name}.rad {stem}.rad > {stem}.oct"),
+        format!("  oconv {static_file} {stem}.rad > {stem}.oct"),
     ];
     if with_theta {
         h.push(format!(

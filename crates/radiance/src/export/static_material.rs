@@ -100,6 +100,7 @@ pub(crate) fn text(
     result: &FitResult,
     chosen: &Chosen,
     name: &str,
+    file: &str,
     with_theta: bool,
     colour: Option<[f64; 3]>,
 ) -> Text {
@@ -125,7 +126,7 @@ pub(crate) fn text(
     h.extend([
         format!(
             "{}: static Radiance {what} \"{name}\", written by brtf {} (brtf export).",
-            super::static_file_name(name),
+            file,
             env!("CARGO_PKG_VERSION")
         ),
         String::new(),
@@ -144,7 +145,7 @@ pub(crate) fn text(
     if !caveats.is_empty() {
         notes.push(format!(
             "{}: not renderable as is: the fit had a free scale, so its reflectance is relative (see its header)",
-            super::static_file_name(name)
+            file
         ));
     }
     match chosen.origin {
@@ -179,8 +180,7 @@ pub(crate) fn text(
                 if result.global.is_none() {
                     notes.push(format!(
                         "{}: no all-incidence fit, so the static material is the fit at θ_in = {}°",
-                        super::static_file_name(name),
-                        r.theta_in
+                        file, r.theta_in
                     ));
                 }
             }
@@ -212,8 +212,7 @@ pub(crate) fn text(
     if options.variant != Variant::Radiance {
         notes.push(format!(
             "{}: fitted with variant {}, which current rtrace does not compute (see its header)",
-            super::static_file_name(name),
-            options.variant
+            file, options.variant
         ));
         if with_theta {
             h.push(format!(

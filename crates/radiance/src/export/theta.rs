@@ -47,6 +47,7 @@ pub(crate) fn build(
     result: &FitResult,
     table: &ParamTable,
     name: &str,
+    static_file: &str,
     colour: Option<[f64; 3]>,
 ) -> Result<Theta, ExportError> {
     let kind = table.kind;
@@ -302,8 +303,7 @@ not what rtrace computes for a static {label} with the same parameters."
     }
     h.push(String::new());
     h.push(format!(
-        "Same identifier as {}: give oconv one or the other.",
-        super::static_file_name(name)
+        "Same identifier as {static_file}: give oconv one or the other."
     ));
     let mut rad = comment_block(&h);
     rad += &format_primitive(&primitive);
