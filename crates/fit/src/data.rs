@@ -179,7 +179,7 @@ struct PairIter<'a> {
 impl Iterator for PairIter<'_> {
     type Item = (DVec3, DVec3);
 
-    #[inline]
+    #[inline(always)]
     fn next(&mut self) -> Option<(DVec3, DVec3)> {
         if self.k >= self.n {
             return None;

@@ -86,7 +86,7 @@ pub use residuals::{residual_rows, residuals_header};
 pub use result::{FIT_JSON_SCHEMA, FitResult, InputFile, Provenance, ReadFitError, SetWarning};
 pub use set::{
     FitSetError, FitSetOptions, FittedSet, KlemsOptions, NoProgress, Progress, fit_set,
-    fit_set_with_data, prepare_input,
+    fit_set_with_data, prepare_input, prepare_inputs_of_xml,
 };
 pub use summary::{summary, warning_lines};
 pub use table::{AzimuthRing, Interpolation, ParamTable, TableError, TableLookup, azimuth_from_u};

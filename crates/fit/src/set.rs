@@ -506,6 +506,51 @@ pub fn prepare_input(
     }
 }
 
+/// [`prepare_input`] of several incidences of one BSDF XML file, read
+/// once (a Klems side has 145: parsing the file for each took most of the
+/// side-by-side report's time), in parallel and in order.
+pub fn prepare_inputs_of_xml(
+    recipe: &Recipe,
+    inputs: &[&InputFile],
+    bytes: &[u8],
+    path: &Path,
+) -> Result<Vec<PreparedMeasurement>, FitSetError> {
+    let xml = brtf_gonio::klems::read_any_bytes(bytes, path)?;
+    let directions = match (&xml, recipe.patch_average) {
+        (brtf_gonio::klems::BsdfXml::Klems(bsdf), Some(rule)) => {
+            Some(crate::klems::PatchDirections::new(&bsdf.basis, &rule))
+        }
+        _ => None,
+    };
+    inputs
+        .par_iter()
+        .map(|input| {
+            let label = input.label();
+            let at = input.klems.ok_or(FitSetError::NoIncidences)?;
+            let prepared = match &xml {
+                brtf_gonio::klems::BsdfXml::Klems(bsdf) => crate::klems::prepare_patch_sharing(
+                    recipe,
+                    bsdf,
+                    at,
+                    &label,
+                    directions.as_ref(),
+                )?,
+                brtf_gonio::klems::BsdfXml::TensorTree(tree) => crate::ttree::prepare_incidence(
+                    recipe,
+                    tree,
+                    at.side,
+                    input.theta_in,
+                    input.phi_in,
+                    &label,
+                )?,
+            };
+            let mut prepared = prepared.ok_or(FitSetError::NoIncidences)?;
+            prepared.source = label;
+            Ok(prepared)
+        })
+        .collect()
+}
+
 /// A warning when `rho` equals, to its printed digits, a number of one of
 /// the header's integrals (`#integrated_value`, `#front_integral`, …):
 /// detector integrals a user may take for a reflectance.

@@ -161,7 +161,7 @@ impl GeometryBatch {
 
 impl Extend<Geometry> for GeometryBatch {
     fn extend<I: IntoIterator<Item = Geometry>>(&mut self, iter: I) {
-        let iter = iter.into_iter();
+        let mut iter = iter.into_iter();
         let (low, high) = iter.size_hint();
         if high != Some(low) {
             self.reserve(low);
@@ -192,7 +192,6 @@ impl Extend<Geometry> for GeometryBatch {
             .zip(&mut self.x_u[start..])
             .zip(&mut self.x_v[start..])
             .zip(&mut self.cutoff_factor[start..]);
-        let mut iter = iter.peekable();
         let mut written = 0;
         for ((((((lc, vc), lf), xu), xv), cf), g) in rows.zip(&mut iter) {
             *lc = g.light_cosine;

@@ -11,6 +11,7 @@ use crate::colour::diverging;
 use crate::report::esc;
 use brtf_fit::{FitResult, PreparedMeasurement};
 use brtf_model::CompositeBsdf;
+use rayon::prelude::*;
 use std::fmt::Write;
 use std::path::Path;
 
@@ -29,10 +30,9 @@ struct PatchRow {
 }
 
 /// The figures of every incidence of one side's fit (`None` with the
-/// reason when the Klems file cannot be read).
+/// reason when the Klems file cannot be read). Each file is read once.
 fn rows(result: &FitResult, fit_dir: &Path) -> Result<Vec<PatchRow>, String> {
-    let mut rows = Vec::new();
-    let mut cache: Option<(String, Vec<u8>, std::path::PathBuf)> = None;
+    let mut inputs = Vec::with_capacity(result.incidences.len());
     for (index, report) in result.incidences.iter().enumerate() {
         let input = result
             .input_of(index)
@@ -40,21 +40,32 @@ fn rows(result: &FitResult, fit_dir: &Path) -> Result<Vec<PatchRow>, String> {
         let Some(at) = input.klems else {
             return Err(format!("{}: not a Klems patch", input.path));
         };
-        if cache.as_ref().is_none_or(|(p, _, _)| *p != input.path) {
-            let path = brtf_io::locate_input(&input.path, fit_dir, &[])
-                .ok_or_else(|| format!("{}: Klems file not found", input.path))?;
-            let bytes =
-                brtf_io::read_input(&path).map_err(|e| format!("{}: {e}", path.display()))?;
-            cache = Some((input.path.clone(), bytes, path));
-        }
-        let (_, bytes, path) = cache.as_ref().expect("just filled");
-        let prepared = brtf_fit::prepare_input(&result.recipe, input, bytes, path)
+        inputs.push((input, at, report));
+    }
+    let mut rows = Vec::with_capacity(inputs.len());
+    // Runs of incidences from one file (a side's fit has one).
+    for run in inputs.chunk_by(|a, b| a.0.path == b.0.path) {
+        let first = run[0].0;
+        let path = brtf_io::locate_input(&first.path, fit_dir, &[])
+            .ok_or_else(|| format!("{}: Klems file not found", first.path))?;
+        let bytes = brtf_io::read_input(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let files: Vec<&brtf_fit::InputFile> = run.iter().map(|(input, _, _)| *input).collect();
+        let prepared = brtf_fit::prepare_inputs_of_xml(&result.recipe, &files, &bytes, &path)
             .map_err(|e| e.to_string())?;
-        let material = result
-            .composite_of(report)
-            .ok_or_else(|| format!("{}: the fitted arguments are not a material", input.label()))?;
-        let bsdf = CompositeBsdf::new(&material, &result.options());
-        rows.push(row(&prepared, &bsdf, report.scale, at.patch, report));
+        let built: Vec<Result<PatchRow, String>> = run
+            .par_iter()
+            .zip(&prepared)
+            .map(|((input, at, report), prepared)| {
+                let material = result.composite_of(report).ok_or_else(|| {
+                    format!("{}: the fitted arguments are not a material", input.label())
+                })?;
+                let bsdf = CompositeBsdf::new(&material, &result.options());
+                Ok(row(prepared, &bsdf, report.scale, at.patch, report))
+            })
+            .collect();
+        for r in built {
+            rows.push(r?);
+        }
     }
     Ok(rows)
 }
