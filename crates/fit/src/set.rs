@@ -479,26 +479,10 @@ pub fn prepare_input(
     bytes: &[u8],
     path: &Path,
 ) -> Result<PreparedMeasurement, FitSetError> {
-    let label = input.label();
     match input.klems {
-        Some(at) => {
-            let prepared = match brtf_gonio::klems::read_any_bytes(bytes, path)? {
-                brtf_gonio::klems::BsdfXml::Klems(bsdf) => {
-                    crate::klems::prepare_patch(recipe, &bsdf, at, &label)?
-                }
-                brtf_gonio::klems::BsdfXml::TensorTree(tree) => crate::ttree::prepare_incidence(
-                    recipe,
-                    &tree,
-                    at.side,
-                    input.theta_in,
-                    input.phi_in,
-                    &label,
-                )?,
-            };
-            let mut prepared = prepared.ok_or(FitSetError::NoIncidences)?;
-            prepared.source = label;
-            Ok(prepared)
-        }
+        Some(_) => prepare_inputs_of_xml(recipe, &[input], bytes, path)?
+            .pop()
+            .ok_or(FitSetError::NoIncidences),
         None => {
             let measurement = brtf_gonio::read_bytes(bytes, path)?;
             Ok(recipe.prepare(measurement, &input.path)?)

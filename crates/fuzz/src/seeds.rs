@@ -382,7 +382,7 @@ fn rewritten(text: &str, name: &str) -> Result<String, String> {
 
 /// `bsdf` as brtf's Klems writer writes it.
 pub(crate) fn rewrite(bsdf: &brtf_gonio::klems::KlemsBsdf, name: &str) -> Result<String, String> {
-    use brtf_gonio::klems::{KlemsWriteBlock, KlemsWriteHeader, to_klems_xml};
+    use brtf_gonio::klems::{KlemsWriteHeader, to_klems_xml};
     let header = KlemsWriteHeader {
         name: bsdf.header.name.clone().unwrap_or_default(),
         manufacturer: "brtf-fuzz".into(),
@@ -391,16 +391,7 @@ pub(crate) fn rewrite(bsdf: &brtf_gonio::klems::KlemsBsdf, name: &str) -> Result
         window: Default::default(),
         comment: vec![format!("rewritten from {name} -- by brtf-fuzz")],
     };
-    let blocks: Vec<KlemsWriteBlock> = bsdf
-        .matrices
-        .iter()
-        .map(|m| KlemsWriteBlock {
-            band: m.band.clone(),
-            direction: m.direction,
-            values: m.values.clone(),
-        })
-        .collect();
-    to_klems_xml(&header, &bsdf.basis, &blocks)
+    to_klems_xml(&header, &bsdf.basis, &bsdf.write_blocks())
 }
 
 /// The Klems file at `path` resampled to the Quarter basis, as XML text.

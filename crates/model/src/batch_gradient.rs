@@ -79,14 +79,7 @@ impl GeometryBatch {
 
     /// Room for `n` more pairs.
     pub fn reserve(&mut self, n: usize) {
-        for column in [
-            &mut self.light_cosine,
-            &mut self.view_cosine,
-            &mut self.lobe_factor,
-            &mut self.x_u,
-            &mut self.x_v,
-            &mut self.cutoff_factor,
-        ] {
+        for column in self.columns_mut() {
             column.reserve(n);
         }
     }
@@ -100,6 +93,18 @@ impl GeometryBatch {
         self.x_u.push(g.x_u);
         self.x_v.push(g.x_v);
         self.cutoff_factor.push(g.cutoff_factor);
+    }
+
+    /// Every column, for what is done to all alike.
+    fn columns_mut(&mut self) -> [&mut Vec<f64>; 6] {
+        [
+            &mut self.light_cosine,
+            &mut self.view_cosine,
+            &mut self.lobe_factor,
+            &mut self.x_u,
+            &mut self.x_v,
+            &mut self.cutoff_factor,
+        ]
     }
 
     /// Pair `i`'s geometry, as pushed.
@@ -129,14 +134,7 @@ impl GeometryBatch {
 
     /// Removes every pair (keeps the storage).
     pub fn clear(&mut self) {
-        for column in [
-            &mut self.light_cosine,
-            &mut self.view_cosine,
-            &mut self.lobe_factor,
-            &mut self.x_u,
-            &mut self.x_v,
-            &mut self.cutoff_factor,
-        ] {
+        for column in self.columns_mut() {
             column.clear();
         }
     }
@@ -175,14 +173,7 @@ impl Extend<Geometry> for GeometryBatch {
         // recomputes patch pairs' geometry on every pass spends most of
         // its time here).
         let start = self.len();
-        for column in [
-            &mut self.light_cosine,
-            &mut self.view_cosine,
-            &mut self.lobe_factor,
-            &mut self.x_u,
-            &mut self.x_v,
-            &mut self.cutoff_factor,
-        ] {
+        for column in self.columns_mut() {
             column.resize(start + low, 0.0);
         }
         let rows = self.light_cosine[start..]
@@ -204,14 +195,7 @@ impl Extend<Geometry> for GeometryBatch {
         }
         // An iterator whose length was not what it said.
         if written < low {
-            for column in [
-                &mut self.light_cosine,
-                &mut self.view_cosine,
-                &mut self.lobe_factor,
-                &mut self.x_u,
-                &mut self.x_v,
-                &mut self.cutoff_factor,
-            ] {
+            for column in self.columns_mut() {
                 column.truncate(start + written);
             }
         }

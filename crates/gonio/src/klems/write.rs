@@ -325,16 +325,19 @@ impl super::KlemsBsdf {
             window,
             comment,
         };
-        let blocks: Vec<KlemsWriteBlock> = self
-            .matrices
+        to_klems_xml(&header, &self.basis, &self.write_blocks())
+    }
+
+    /// Every matrix as the writer takes it, in file order.
+    pub fn write_blocks(&self) -> Vec<KlemsWriteBlock> {
+        self.matrices
             .iter()
             .map(|m| KlemsWriteBlock {
                 band: m.band.clone(),
                 direction: m.direction,
                 values: m.values.clone(),
             })
-            .collect();
-        to_klems_xml(&header, &self.basis, &blocks)
+            .collect()
     }
 }
 
