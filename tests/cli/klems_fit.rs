@@ -587,4 +587,25 @@ fn a_static_material_whose_energy_is_off_is_written_under_a_name_that_says_so() 
         first.contains(&format!("{grazing:.3}")),
         "{first} vs {grazing}"
     );
+    // An earlier export's `<name>.rad` would be taken for this material:
+    // `brtf export` removes it; a file brtf did not write stays, with a note.
+    let plain = out.join(format!("{name}.rad"));
+    std::fs::write(&plain, &text).unwrap();
+    let run = brtf(&["export", s(&out)], "");
+    assert!(run.success, "{run:?}");
+    let printed = format!("{}{}", run.stdout, run.stderr);
+    assert!(!plain.exists(), "{printed}");
+    assert!(
+        printed.contains(&format!("removed {name}.rad")),
+        "{printed}"
+    );
+    std::fs::write(&plain, "void plastic mine 0 0 5 .5 .5 .5 0 0\n").unwrap();
+    let run = brtf(&["export", s(&out)], "");
+    assert!(run.success, "{run:?}");
+    assert!(plain.exists());
+    let printed = format!("{}{}", run.stdout, run.stderr);
+    assert!(
+        printed.contains(&format!("{name}.rad is still in the folder")),
+        "{printed}"
+    );
 }

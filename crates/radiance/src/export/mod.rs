@@ -306,10 +306,37 @@ pub fn write_exports(
         write_atomically(&path, file.text.as_bytes())?;
         files.push(path);
     }
-    Ok(Exported {
-        files,
-        notes: export.notes,
-    })
+    let mut notes = export.notes;
+    notes.extend(remove_other_static_file(
+        dir,
+        &export.name,
+        &export.files[0].file_name,
+    ));
+    Ok(Exported { files, notes })
+}
+
+/// An earlier export's static material under the other name (`<name>.rad`
+/// after `<name>-energy-off.rad` or the reverse) would be taken for this
+/// one: it is removed when its header says brtf exported it, and a note
+/// says so. A file of another origin is left alone, with a note.
+fn remove_other_static_file(dir: &Path, name: &str, written: &str) -> Option<String> {
+    let other = [static_file_name(name), energy_off_file_name(name)]
+        .into_iter()
+        .find(|f| f != written)?;
+    let path = dir.join(&other);
+    let text = std::fs::read_to_string(&path).ok()?;
+    let ours = text.lines().take(3).any(|l| {
+        l.starts_with('#') && l.contains("written by brtf") && l.contains("(brtf export)")
+    });
+    if ours && std::fs::remove_file(&path).is_ok() {
+        Some(format!(
+            "removed {other}, an earlier export's static material: {written} replaces it"
+        ))
+    } else {
+        Some(format!(
+            "{other} is still in the folder and is not this export's static material ({written} is)"
+        ))
+    }
 }
 
 /// Writes `bytes` atomically (see [`brtf_io::write_atomic`]).
