@@ -227,6 +227,88 @@ fn patch_sum_pair<const CH: usize>(
     });
 }
 
+/// Klems-like samples: 32 lights of an incident patch around θ = 30°
+/// with 32 views of an outgoing patch, which is the mirror patch, the
+/// straight-through patch, or one of a ring on either side.
+fn klems_products() -> (Vec<DVec3>, Vec<Vec<DVec3>>) {
+    let mut state = 0x2545_F491_4F6C_DD1Du64;
+    let mut uniform = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut patch = |theta: f64, phi: f64| -> Vec<DVec3> {
+        (0..32)
+            .map(|_| {
+                direction(
+                    theta + 10.0 * (uniform() - 0.5),
+                    phi + 10.0 * (uniform() - 0.5),
+                )
+            })
+            .collect()
+    };
+    let lights = patch(30.0, 0.0);
+    let views = (0..96)
+        .map(|s| match s % 6 {
+            0 => patch(30.0, 180.0),
+            1 => patch(150.0, 180.0),
+            2 | 3 => patch(10.0 + 13.0 * (s % 7) as f64, 30.0 * s as f64),
+            _ => patch(170.0 - 13.0 * (s % 7) as f64, 30.0 * s as f64),
+        })
+        .collect();
+    (lights, views)
+}
+
+/// What a fit to patch averages that cannot keep the geometry does on
+/// every pass: each sample's pairs' geometry into a scratch batch.
+/// `{type}/scalar`: `Bsdf::geometry` per pair; `{type}/simd`:
+/// `geometry_product`. Rates are pairs per second.
+fn bench_patch_geometry(c: &mut Criterion) {
+    let (lights, samples) = klems_products();
+    let mut group = c.benchmark_group("patch_geometry");
+    group.throughput(Throughput::Elements(
+        (lights.len() * samples.iter().map(Vec::len).sum::<usize>()) as u64,
+    ));
+    for kind in [
+        MaterialKind::Trans,
+        MaterialKind::Plastic,
+        MaterialKind::Trans2,
+    ] {
+        let bsdf = Bsdf::new(&material(kind), &EvalOptions::default());
+        group.bench_function(format!("{}/scalar", kind.name()), |b| {
+            let mut scratch = GeometryBatch::new();
+            b.iter(|| {
+                let mut total = 0;
+                for views in &samples {
+                    scratch.clear();
+                    let bsdf = black_box(&bsdf);
+                    let pairs = lights
+                        .iter()
+                        .flat_map(|&l| views.iter().map(move |&v| (l, v)));
+                    scratch.extend(pairs.map(|(l, v)| bsdf.geometry(l, v)));
+                    black_box(scratch.get(scratch.len() / 2));
+                    total += scratch.len();
+                }
+                total
+            })
+        });
+        group.bench_function(format!("{}/simd", kind.name()), |b| {
+            let mut scratch = GeometryBatch::new();
+            b.iter(|| {
+                let mut total = 0;
+                for views in &samples {
+                    black_box(&bsdf).geometry_product(&lights, views, &mut scratch, 0);
+                    black_box(scratch.get(scratch.len() / 2));
+                    total += scratch.len();
+                }
+                total
+            })
+        });
+    }
+    group.finish();
+}
+
 fn bench_albedo(c: &mut Criterion) {
     let mut group = c.benchmark_group("albedo");
     for (kind, theta) in [
@@ -250,6 +332,7 @@ criterion_group!(
     bench_eval,
     bench_eval_batch,
     bench_patch_sum,
+    bench_patch_geometry,
     bench_albedo
 );
 criterion_main!(benches);

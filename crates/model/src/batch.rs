@@ -26,7 +26,7 @@ use glam::DVec3;
 use std::f64::consts::PI;
 
 /// rtrace clamps the view cosine to at least this (`pdot >= .001`).
-const MIN_VIEW_COSINE: f64 = 0.001;
+pub(crate) const MIN_VIEW_COSINE: f64 = 0.001;
 
 /// Unit directions in the local frame as three coordinate arrays.
 #[derive(Debug, Clone, Default, PartialEq)]

@@ -107,6 +107,30 @@ impl GeometryBatch {
         ]
     }
 
+    /// The columns of pairs `at..at + n`, in the order light cosine, view
+    /// cosine, lobe factor, x_u, x_v, cut-off factor, for a writer that
+    /// fills all six. The batch grows to `at + n` pairs if it is shorter
+    /// (with zeros); the values there are what it held, and the pairs
+    /// past `at + n` stay: a scratch batch refilled sample after sample
+    /// is neither cleared nor zero-filled again.
+    ///
+    /// # Panics
+    /// If `at > self.len()`.
+    pub(crate) fn columns_at(&mut self, at: usize, n: usize) -> [&mut [f64]; 6] {
+        assert!(
+            at <= self.len(),
+            "GeometryBatch: writing at {at}, past the {} pairs held",
+            self.len()
+        );
+        let end = at + n;
+        if self.len() < end {
+            for column in self.columns_mut() {
+                column.resize(end, 0.0);
+            }
+        }
+        self.columns_mut().map(|column| &mut column[at..end])
+    }
+
     /// Pair `i`'s geometry, as pushed.
     ///
     /// # Panics
@@ -303,7 +327,7 @@ impl Bsdf {
     /// Runs `kernel` compiled for this material's switches: its type's
     /// anisotropy and transmission, the formula set, and rtrace's Fresnel
     /// switch.
-    fn by_switches<K: SwitchedKernel>(&self, kernel: K) -> K::Output {
+    pub(crate) fn by_switches<K: SwitchedKernel>(&self, kernel: K) -> K::Output {
         let k = self.batch_constants();
         let variant = self.options().variant;
         let fresnel = self.has_fresnel();
@@ -328,7 +352,7 @@ impl Bsdf {
 
 /// A kernel compiled once per material switch: anisotropic, transmitting,
 /// the formula set `V` and rtrace's Fresnel switch.
-trait SwitchedKernel {
+pub(crate) trait SwitchedKernel {
     type Output;
     fn run<const ANISO: bool, const TRANS: bool, const V: u8, const FRESNEL: bool>(
         self,
@@ -750,64 +774,64 @@ const BLOCK_VECTORS: usize = 8;
 
 /// pulp's vector operations under short names.
 #[derive(Clone, Copy)]
-struct Ops<S>(S);
+pub(crate) struct Ops<S>(pub(crate) S);
 
 impl<S: pulp::Simd> Ops<S> {
     #[inline(always)]
-    fn splat(self, x: f64) -> S::f64s {
+    pub(crate) fn splat(self, x: f64) -> S::f64s {
         self.0.splat_f64s(x)
     }
     #[inline(always)]
-    fn add(self, a: S::f64s, b: S::f64s) -> S::f64s {
+    pub(crate) fn add(self, a: S::f64s, b: S::f64s) -> S::f64s {
         self.0.add_f64s(a, b)
     }
     #[inline(always)]
-    fn sub(self, a: S::f64s, b: S::f64s) -> S::f64s {
+    pub(crate) fn sub(self, a: S::f64s, b: S::f64s) -> S::f64s {
         self.0.sub_f64s(a, b)
     }
     #[inline(always)]
-    fn mul(self, a: S::f64s, b: S::f64s) -> S::f64s {
+    pub(crate) fn mul(self, a: S::f64s, b: S::f64s) -> S::f64s {
         self.0.mul_f64s(a, b)
     }
     #[inline(always)]
-    fn div(self, a: S::f64s, b: S::f64s) -> S::f64s {
+    pub(crate) fn div(self, a: S::f64s, b: S::f64s) -> S::f64s {
         self.0.div_f64s(a, b)
     }
     #[inline(always)]
-    fn neg(self, a: S::f64s) -> S::f64s {
+    pub(crate) fn neg(self, a: S::f64s) -> S::f64s {
         self.0.neg_f64s(a)
     }
     #[inline(always)]
-    fn lt(self, a: S::f64s, b: S::f64s) -> S::m64s {
+    pub(crate) fn lt(self, a: S::f64s, b: S::f64s) -> S::m64s {
         self.0.less_than_f64s(a, b)
     }
     #[inline(always)]
-    fn le(self, a: S::f64s, b: S::f64s) -> S::m64s {
+    pub(crate) fn le(self, a: S::f64s, b: S::f64s) -> S::m64s {
         self.0.less_than_or_equal_f64s(a, b)
     }
     #[inline(always)]
-    fn gt(self, a: S::f64s, b: S::f64s) -> S::m64s {
+    pub(crate) fn gt(self, a: S::f64s, b: S::f64s) -> S::m64s {
         self.0.greater_than_f64s(a, b)
     }
     #[inline(always)]
-    fn ge(self, a: S::f64s, b: S::f64s) -> S::m64s {
+    pub(crate) fn ge(self, a: S::f64s, b: S::f64s) -> S::m64s {
         self.0.greater_than_or_equal_f64s(a, b)
     }
     #[inline(always)]
-    fn and(self, a: S::m64s, b: S::m64s) -> S::m64s {
+    pub(crate) fn and(self, a: S::m64s, b: S::m64s) -> S::m64s {
         self.0.and_m64s(a, b)
     }
     #[inline(always)]
-    fn or(self, a: S::m64s, b: S::m64s) -> S::m64s {
+    pub(crate) fn or(self, a: S::m64s, b: S::m64s) -> S::m64s {
         self.0.or_m64s(a, b)
     }
     #[inline(always)]
-    fn not(self, a: S::m64s) -> S::m64s {
+    pub(crate) fn not(self, a: S::m64s) -> S::m64s {
         self.0.not_m64s(a)
     }
     /// All lanes `value`.
     #[inline(always)]
-    fn mask(self, value: bool) -> S::m64s {
+    pub(crate) fn mask(self, value: bool) -> S::m64s {
         let zero = self.splat(0.0);
         if value {
             self.le(zero, zero)
@@ -817,14 +841,14 @@ impl<S: pulp::Simd> Ops<S> {
     }
     /// `if mask { a } else { b }` per lane.
     #[inline(always)]
-    fn select(self, mask: S::m64s, a: S::f64s, b: S::f64s) -> S::f64s {
+    pub(crate) fn select(self, mask: S::m64s, a: S::f64s, b: S::f64s) -> S::f64s {
         self.0.select_f64s(mask, a, b)
     }
 
     /// [`exp_lane`] on every lane, operation for operation (the same
     /// values, bit for bit).
     #[inline(always)]
-    fn exp(self, x: S::f64s) -> S::f64s {
+    pub(crate) fn exp(self, x: S::f64s) -> S::f64s {
         const LN2_HI: f64 = EXP_LN2_HI;
         const LN2_LO: f64 = EXP_LN2_LO;
         const FLUSH_BELOW: f64 = EXP_FLUSH_BELOW;
@@ -879,6 +903,10 @@ impl<S: pulp::Simd> Ops<S> {
 /// rest 0). Mirrors `Bsdf::eval_impl` (with its `add_reflection`,
 /// `add_transmission` and lobes) operation for operation, every branch
 /// computed and the right one selected per lane.
+///
+/// A vector whose pairs all have the light in front (or all behind), as
+/// a Klems patch pair's do, computes that side's terms alone: the other
+/// side's would not be selected, so the values are the same bits.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn simd_terms<
@@ -889,6 +917,74 @@ fn simd_terms<
     const TRANS: bool,
     const V: u8,
     const FRESNEL: bool,
+>(
+    o: Ops<S>,
+    k: &Constants,
+    ci: S::f64s,
+    co: S::f64s,
+    lobe_factor: S::f64s,
+    xu: S::f64s,
+    xv: S::f64s,
+    cutoff_factor: S::f64s,
+) -> [[S::f64s; 3]; ROWS] {
+    if TRANS {
+        let all = |m: S::m64s| o.0.first_true_m64s(o.not(m)) == S::F64_LANES;
+        if all(o.gt(ci, o.splat(FTINY))) {
+            return simd_terms_on::<S, GRAD, CH, ANISO, TRANS, V, FRESNEL, FRONT>(
+                o,
+                k,
+                ci,
+                co,
+                lobe_factor,
+                xu,
+                xv,
+                cutoff_factor,
+            );
+        }
+        if all(o.lt(ci, o.splat(-FTINY))) {
+            return simd_terms_on::<S, GRAD, CH, ANISO, TRANS, V, FRESNEL, BEHIND>(
+                o,
+                k,
+                ci,
+                co,
+                lobe_factor,
+                xu,
+                xv,
+                cutoff_factor,
+            );
+        }
+    }
+    simd_terms_on::<S, GRAD, CH, ANISO, TRANS, V, FRESNEL, BOTH>(
+        o,
+        k,
+        ci,
+        co,
+        lobe_factor,
+        xu,
+        xv,
+        cutoff_factor,
+    )
+}
+
+/// [`simd_terms`] for vectors whose lights are on either side.
+const BOTH: u8 = 0;
+/// ... all in front (light cosine > FTINY): transmission terms not computed.
+const FRONT: u8 = 1;
+/// ... all behind (light cosine < −FTINY): reflection terms not computed.
+const BEHIND: u8 = 2;
+
+/// [`simd_terms`] for pairs on the sides `SIDE`.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn simd_terms_on<
+    S: pulp::Simd,
+    const GRAD: bool,
+    const CH: usize,
+    const ANISO: bool,
+    const TRANS: bool,
+    const V: u8,
+    const FRESNEL: bool,
+    const SIDE: u8,
 >(
     o: Ops<S>,
     k: &Constants,
@@ -950,20 +1046,20 @@ fn simd_terms<
     // One exp for the lobe of whichever side the pair is on. FRESNEL
     // implies roughness 0: no lobe at all.
     let exponent = if ANISO {
-        let reflected = o.neg(o.add(o.mul(xu, sp(k.inv_wu)), o.mul(xv, sp(k.inv_wv))));
-        if TRANS {
-            let through = o.neg(o.add(o.div(xu, sp(k.bu)), o.div(xv, sp(k.bv))));
-            o.select(light_behind, through, reflected)
-        } else {
-            reflected
+        let reflected = || o.neg(o.add(o.mul(xu, sp(k.inv_wu)), o.mul(xv, sp(k.inv_wv))));
+        let through = || o.neg(o.add(o.div(xu, sp(k.bu)), o.div(xv, sp(k.bv))));
+        match (TRANS, SIDE) {
+            (false, _) | (_, FRONT) => reflected(),
+            (_, BEHIND) => through(),
+            _ => o.select(light_behind, through(), reflected()),
         }
     } else {
-        let reflected = o.mul(o.neg(xu), sp(k.inv_wu));
-        if TRANS {
-            let through = o.div(o.neg(xu), sp(k.bu));
-            o.select(light_behind, through, reflected)
-        } else {
-            reflected
+        let reflected = || o.mul(o.neg(xu), sp(k.inv_wu));
+        let through = || o.div(o.neg(xu), sp(k.bu));
+        match (TRANS, SIDE) {
+            (false, _) | (_, FRONT) => reflected(),
+            (_, BEHIND) => through(),
+            _ => o.select(light_behind, through(), reflected()),
         }
     };
     let e = if FRESNEL { zero } else { o.exp(exponent) };
@@ -994,7 +1090,7 @@ fn simd_terms<
         o.mask(true)
     };
     // The transmitted lobe.
-    let (t_value, t_du, t_dv, t_passes) = if !TRANS {
+    let (t_value, t_du, t_dv, t_passes) = if !TRANS || SIDE == FRONT {
         (zero, zero, zero, o.mask(false))
     } else if ANISO {
         let root = sp(PI * k.b_root);
@@ -1036,8 +1132,12 @@ fn simd_terms<
     let t_k = o.div(o.mul(td, light_fresnel), sp(PI));
     let g_lf = o.div(light_fresnel, sp(PI));
     let da = k.dalpha2;
-    let pick = |reflected: S::f64s, through: S::f64s| {
-        o.select(front, reflected, o.select(behind, through, zero))
+    // Only the side(s) SIDE computes are read: the other's terms are
+    // dead code.
+    let pick = |reflected: S::f64s, through: S::f64s| match SIDE {
+        FRONT => o.select(front, reflected, zero),
+        BEHIND => o.select(behind, through, zero),
+        _ => o.select(front, reflected, o.select(behind, through, zero)),
     };
     // Roughness chain rule: coef · (du ∂α²_u/∂a + dv ∂α²_v/∂a).
     let chain = |coef: S::f64s, du: S::f64s, dv: S::f64s, j: usize| {
@@ -1088,15 +1188,16 @@ fn simd_terms<
         };
         let rf = o.select(r_lobe_on, o.add(rf, o.mul(s, r_value)), rf);
         out[0][ch] = pick(rf, zero);
+        let rdc = o.select(r_lobe_on, o.add(rdc, o.mul(ds_dc, r_value)), rdc);
+        let rds = o.select(r_lobe_on, o.add(rds, o.mul(ds_drs, r_value)), rds);
+        let rru = o.select(r_lobe_on, chain(s, r_du, r_dv, 0), zero);
+        let rrv = o.select(r_lobe_on, chain(s, r_du, r_dv, 1), zero);
         if GRAD {
-            let rdc = o.select(r_lobe_on, o.add(rdc, o.mul(ds_dc, r_value)), rdc);
-            let rds = o.select(r_lobe_on, o.add(rds, o.mul(ds_drs, r_value)), rds);
-            let rru = o.select(r_lobe_on, chain(s, r_du, r_dv, 0), zero);
             out[1][ch] = pick(rdc, zero);
             out[2][ch] = pick(rds, zero);
             out[3][ch] = pick(rru, zero);
             if ANISO {
-                out[4][ch] = pick(o.select(r_lobe_on, chain(s, r_du, r_dv, 1), zero), zero);
+                out[4][ch] = pick(rrv, zero);
             }
             if TRANS {
                 out[4 + usize::from(ANISO)][ch] = pick(rdt, zero);
@@ -1147,15 +1248,15 @@ fn simd_terms<
             tdts,
         );
         let tru = o.select(t_lobe_on, chain(coef, t_du, t_dv, 0), zero);
-        out[1][ch] = o.select(front, out[1][ch], o.select(behind, tdc, zero));
-        out[2][ch] = o.select(front, out[2][ch], o.select(behind, tds, zero));
-        out[3][ch] = o.select(front, out[3][ch], o.select(behind, tru, zero));
+        out[1][ch] = pick(rdc, tdc);
+        out[2][ch] = pick(rds, tds);
+        out[3][ch] = pick(rru, tru);
         if ANISO {
             let trv = o.select(t_lobe_on, chain(coef, t_du, t_dv, 1), zero);
-            out[4][ch] = o.select(front, out[4][ch], o.select(behind, trv, zero));
+            out[4][ch] = pick(rrv, trv);
         }
         let it = 4 + usize::from(ANISO);
-        out[it][ch] = o.select(front, out[it][ch], o.select(behind, tdt, zero));
+        out[it][ch] = pick(rdt, tdt);
         out[it + 1][ch] = pick(zero, tdts);
     }
     out
@@ -1184,6 +1285,65 @@ mod tests {
             g: batch.columns(range),
         };
         op.with_simd(simd)
+    }
+
+    /// A vector's terms computed for its side alone (one lane per vector
+    /// on the scalar level: every pair is one-sided) are the bits of the
+    /// terms computed for both sides, on both sides and at the thresholds.
+    #[test]
+    fn one_sided_terms_are_the_two_sided_bits() {
+        fn check<const ANISO: bool, const V: u8, const FRESNEL: bool>(bsdf: &Bsdf) -> usize {
+            let o = Ops(pulp::Scalar::new());
+            let k = bsdf.batch_constants();
+            let mut sided = 0;
+            for i in 0..400 {
+                let theta_in = [0.0, 30.0, 60.0, 85.0, 89.9999][i % 5];
+                let l = direction(theta_in, 10.0 + i as f64);
+                let v = direction((7.3 * i as f64) % 180.0, 190.0 + 0.5 * i as f64);
+                let mut g = bsdf.geometry(l, v);
+                if i % 7 == 0 {
+                    g.light_cosine = [FTINY, -FTINY, 0.0, 2.0 * FTINY][i % 4];
+                }
+                let args = (
+                    g.light_cosine,
+                    g.view_cosine,
+                    g.lobe_factor,
+                    g.x_u,
+                    g.x_v,
+                    g.cutoff_factor,
+                );
+                let one = simd_terms::<_, true, 3, ANISO, true, V, FRESNEL>(
+                    o, &k, args.0, args.1, args.2, args.3, args.4, args.5,
+                );
+                let both = simd_terms_on::<_, true, 3, ANISO, true, V, FRESNEL, BOTH>(
+                    o, &k, args.0, args.1, args.2, args.3, args.4, args.5,
+                );
+                assert_eq!(format!("{one:?}"), format!("{both:?}"), "pair {i}: {g:?}");
+                sided += usize::from(g.light_cosine.abs() > FTINY);
+            }
+            sided
+        }
+        let orient = Some(DVec3::new(0.3, 1.0, 0.2));
+        let trans = |args: &[f64]| Material::new(MaterialKind::Trans, args, None).unwrap();
+        let trans2 = Material::new(
+            MaterialKind::Trans2,
+            &[0.6, 0.7, 0.8, 0.04, 0.05, 0.2, 0.6, 0.4],
+            orient,
+        )
+        .unwrap();
+        let rough = trans(&[0.6, 0.7, 0.8, 0.04, 0.05, 0.6, 0.4]);
+        let smooth = trans(&[0.6, 0.7, 0.8, 0.04, 0.0, 0.6, 0.4]);
+        let with = |m: &Material, v: Variant| Bsdf::new(m, &EvalOptions::with_variant(v));
+        let radiance = Variant::Radiance;
+        assert!(with(&smooth, radiance).has_fresnel());
+        let sided = check::<false, RADIANCE, false>(&with(&rough, radiance))
+            + check::<false, RADIANCE, true>(&with(&smooth, radiance))
+            + check::<false, MANUAL2004, false>(&with(&rough, Variant::Manual2004))
+            + check::<false, WARD1992, false>(&with(&rough, Variant::Ward1992))
+            + check::<true, RADIANCE, false>(&with(&trans2, radiance))
+            + check::<true, MANUAL2004, false>(&with(&trans2, Variant::Manual2004))
+            + check::<true, WARD1992, false>(&with(&trans2, Variant::Ward1992));
+        assert!(sided > 7 * 300, "{sided} one-sided pairs");
     }
 
     /// Whatever level `pulp` picks (AVX-512, AVX2 or the scalar baseline),

@@ -31,6 +31,7 @@
 
 mod albedo;
 mod batch;
+mod batch_geometry;
 mod batch_gradient;
 mod bsdf;
 mod colour;

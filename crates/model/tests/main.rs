@@ -2,6 +2,7 @@
 
 mod albedo;
 mod batch;
+mod batch_geometry;
 mod batch_gradient;
 mod bsdf;
 mod oracle;
