@@ -3,6 +3,7 @@
 //! that builds them itself; the fitter does no I/O).
 
 use brtf_gonio::Gate;
+use brtf_model::{Bsdf, GeometryBatch};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
@@ -147,6 +148,11 @@ impl IndexRange {
             len: range.end.saturating_sub(range.start),
         }
     }
+
+    /// The indices, as a range of the direction table.
+    fn range(self) -> std::ops::Range<usize> {
+        self.start as usize..self.start as usize + self.len as usize
+    }
 }
 
 impl SamplePairs {
@@ -225,6 +231,9 @@ impl Iterator for PairIter<'_> {
 }
 
 impl ExactSizeIterator for PairIter<'_> {}
+
+/// Pairs gathered at a time by [`PatchPairs::geometry`] (on the stack).
+const GATHER: usize = 64;
 
 /// Most pairs per sample in [`PatchPairs::coarse`].
 const COARSE_PAIRS: usize = 32;
@@ -363,6 +372,50 @@ impl PatchPairs {
         }
     }
 
+    /// Writes the geometry of sample `i`'s pairs under `bsdf` as pairs
+    /// `at..at + count(i)` of `out` (`at = out.len()` appends; `at = 0`
+    /// refills a scratch batch without clearing it: its pairs past the
+    /// sample's stay, see [`Bsdf::geometry_product`]), in the order of
+    /// [`PatchPairs::of`]:
+    /// what mapping [`Bsdf::geometry`] over them gives, bit for bit, from
+    /// brtf-model's vectorised geometry (a product's lights each over its
+    /// views; other patterns gathered a few dozen pairs at a time).
+    ///
+    /// # Panics
+    /// If `at > out.len()`.
+    pub fn geometry(&self, bsdf: &Bsdf, i: usize, out: &mut GeometryBatch, at: usize) {
+        let sample = self.samples[i];
+        if let SamplePairs::Product { lights, views } = sample {
+            let table = &self.directions;
+            bsdf.geometry_product(&table[lights.range()], &table[views.range()], out, at);
+            return;
+        }
+        // Written piece by piece.
+        let mut end = at;
+        out.reserve((at + sample.count()).saturating_sub(out.len()));
+        let mut pairs = self.of(i);
+        let mut l = [[0.0; GATHER]; 3];
+        let mut v = [[0.0; GATHER]; 3];
+        loop {
+            let mut m = 0;
+            for (light, view) in pairs.by_ref().take(GATHER) {
+                [l[0][m], l[1][m], l[2][m]] = light.to_array();
+                [v[0][m], v[1][m], v[2][m]] = view.to_array();
+                m += 1;
+            }
+            if m == 0 {
+                return;
+            }
+            bsdf.geometry_soa(
+                [&l[0][..m], &l[1][..m], &l[2][..m]],
+                [&v[0][..m], &v[1][..m], &v[2][..m]],
+                out,
+                end,
+            );
+            end += m;
+        }
+    }
+
     /// The pairs of the samples `indices`, in that order.
     pub fn select(&self, indices: impl IntoIterator<Item = usize>) -> PatchPairs {
         let mut out = PatchPairs {
@@ -412,15 +465,14 @@ impl PatchPairs {
 
     /// The BSDF of sample `i` averaged over its pairs, summed in
     /// brtf-model's vectorised kernel as the fitter sums it.
-    pub fn average(&self, bsdf: &brtf_model::Bsdf, i: usize) -> [f64; 3] {
+    pub fn average(&self, bsdf: &Bsdf, i: usize) -> [f64; 3] {
         thread_local! {
-            static SCRATCH: std::cell::RefCell<brtf_model::GeometryBatch> =
-                std::cell::RefCell::new(brtf_model::GeometryBatch::new());
+            static SCRATCH: std::cell::RefCell<GeometryBatch> =
+                std::cell::RefCell::new(GeometryBatch::new());
         }
         SCRATCH.with_borrow_mut(|scratch| {
-            scratch.clear();
-            scratch.extend(self.of(i).map(|(l, v)| bsdf.geometry(l, v)));
-            let n = scratch.len();
+            self.geometry(bsdf, i, scratch, 0);
+            let n = self.count(i);
             let inverse = 1.0 / n.max(1) as f64;
             bsdf.sum_geometry::<3>(scratch, 0..n).map(|s| s * inverse)
         })
@@ -510,5 +562,49 @@ mod tests {
         let mut many = PatchPairs::new(table(2));
         many.push((0..100).map(|_| (0, 1)));
         assert_eq!(many.coarse().count(0), 25);
+    }
+
+    /// Each pattern's geometry (vectorised) is the scalar geometry of its
+    /// pairs in order, bit for bit, appended after what the batch holds;
+    /// long samples are gathered in several pieces.
+    #[test]
+    fn pattern_geometry_is_the_scalar_geometry() {
+        use brtf_model::{EvalOptions, Material, MaterialKind, direction};
+        let table: Vec<DVec3> = (0..300)
+            .map(|k| direction((k as f64 * 7.7) % 180.0, k as f64 * 13.1))
+            .collect();
+        let mut pairs = PatchPairs::new(table);
+        pairs.push_product(0..5, 100..233);
+        pairs.push_zip(0..7, 10..150);
+        pairs.push((0..150).map(|k| (299 - k, 2 * k)));
+        pairs.push_zip(0..0, 5..9);
+        pairs.push_product(3..3, 5..9);
+        let coarse = pairs.coarse();
+        let material = Material::new(
+            MaterialKind::Trans2,
+            &[0.6, 0.7, 0.8, 0.04, 0.05, 0.2, 0.6, 0.4],
+            Some(DVec3::new(0.3, 1.0, 0.2)),
+        )
+        .unwrap();
+        let bsdf = Bsdf::new(&material, &EvalOptions::default());
+        for set in [&pairs, &coarse] {
+            for i in 0..set.len() {
+                // Appended after one pair, over a stale longer batch.
+                let mut out = GeometryBatch::new();
+                for _ in 0..700 {
+                    out.push(bsdf.geometry(DVec3::Z, DVec3::Z));
+                }
+                set.geometry(&bsdf, i, &mut out, 1);
+                assert_eq!(out.len(), 700.max(1 + set.count(i)));
+                for (k, (l, v)) in set.of(i).enumerate() {
+                    let (got, want) = (out.get(1 + k), bsdf.geometry(l, v));
+                    assert_eq!(
+                        format!("{got:?}"),
+                        format!("{want:?}"),
+                        "sample {i}, pair {k}"
+                    );
+                }
+            }
+        }
     }
 }

@@ -31,7 +31,8 @@ impl PairGeometry {
     pub(crate) fn new(pairs: &PatchPairs, bsdf: &Bsdf) -> PairGeometry {
         let mut geometry = GeometryBatch::with_capacity(pairs.pair_count());
         for i in 0..pairs.len() {
-            geometry.extend(pairs.of(i).map(|(l, v)| bsdf.geometry(l, v)));
+            let end = geometry.len();
+            pairs.geometry(bsdf, i, &mut geometry, end);
         }
         let mut ranges = Vec::with_capacity(pairs.len());
         let mut start = 0;

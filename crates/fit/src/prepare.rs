@@ -188,6 +188,8 @@ pub(crate) fn scan<'a>(
             log_values: Vec::new(),
             channels,
             cosine_weighted: d.cosine_weighted,
+            energy_weights: Vec::new(),
+            energy_rows: Vec::new(),
         },
         stats: ScanStats {
             pieces,
@@ -236,6 +238,7 @@ pub(crate) fn subsample<'a>(b: &Block<'_>, target: usize, bright: f64) -> Block<
     let mut multipliers = Vec::new();
     let mut factors = Vec::new();
     let mut log_values = Vec::new();
+    let mut energy_weights = Vec::new();
     let expand = (step as f64).sqrt();
     for (i, s) in b.samples.iter().enumerate() {
         let mean = channel_mean(s, channels);
@@ -248,6 +251,9 @@ pub(crate) fn subsample<'a>(b: &Block<'_>, target: usize, bright: f64) -> Block<
         };
         samples.push(*s);
         kept.push(i);
+        if let Some(w) = b.energy_weights.get(i) {
+            energy_weights.push(w * m * m);
+        }
         multipliers.push(m * b.multipliers.as_ref().map_or(1.0, |r| r[i]));
         factors.extend(
             b.factors[i * channels..(i + 1) * channels]
@@ -258,7 +264,7 @@ pub(crate) fn subsample<'a>(b: &Block<'_>, target: usize, bright: f64) -> Block<
             log_values.extend_from_slice(&b.log_values[i * channels..(i + 1) * channels]);
         }
     }
-    Block {
+    let mut sub = Block {
         light: b.light,
         samples: Cow::Owned(samples),
         pairs: b
@@ -281,7 +287,11 @@ pub(crate) fn subsample<'a>(b: &Block<'_>, target: usize, bright: f64) -> Block<
         log_values,
         channels,
         cosine_weighted: b.cosine_weighted,
-    }
+        energy_weights,
+        energy_rows: Vec::new(),
+    };
+    sub.set_energy_rows();
+    sub
 }
 
 /// Lobe features read off the data of one incidence.
