@@ -32,6 +32,7 @@ def fit(
     gray: bool = False,
     residual: Literal["absolute", "relative", "log"] = "absolute",
     loss: str = "none",
+    energy: Literal["free", "exact"] = "free",
     name: Optional[str] = None,
     variant: Variant = "radiance",
     fresnel_k: Optional[FresnelK] = None,

@@ -186,6 +186,9 @@ def test_messages_are_in_python_terms(alu, klems_fabric, tmp_path):
          "emissivity=0.9 with ir_transmittance=0.3: their sum exceeds 1"),
         (lambda: m.to_klems("eighth"), brtf.ModelError, 'basis="eighth"'),
         (lambda: brtf.read_klems(klems_fabric).measurements(side="up"), brtf.ModelError, "side='up'"),
+        (lambda: brtf.fit(alu, model="metal", energy="exact", weights="uniform"), brtf.FitError,
+         'energy="exact" integrates the data over their solid angles, which uniform weights (weights="uniform")'),
+        (lambda: brtf.fit(alu, model="metal", energy="some"), brtf.ModelError, "energy="),
     ]
     for call, kind, wording in cases:
         with pytest.raises(kind) as e:

@@ -51,6 +51,29 @@ impl std::str::FromStr for ModelChoice {
     }
 }
 
+/// How a fit treats each incidence's energy: its directional-hemispherical
+/// reflectance and transmittance over the fitted directions.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum EnergyRule {
+    /// The residuals alone decide: a model that cannot follow the data's
+    /// shape may carry more or less light than they do.
+    #[default]
+    Free,
+    /// Each incidence's model carries the data's energy, per side and
+    /// channel (Σ ΔΩ |cos θ_out| m = Σ ΔΩ |cos θ_out| y over its fitted
+    /// samples), and the residuals fit the shape within that: stiff
+    /// penalty rows, met to about 1e-6 relative where the model can
+    /// meet them. An all-incidence fit meets them as nearly as it can
+    /// over every incidence.
+    Exact,
+}
+
+brtf_model::option_words!(EnergyRule {
+    Free => "free",
+    Exact => "exact",
+});
+
 /// Robust loss, applied by iteratively reweighting the residuals.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
 pub enum RobustLoss {
@@ -152,6 +175,9 @@ pub struct FitConfig {
     /// (`orient`), not fixed by `orientation`.
     #[serde(default)]
     pub oriented: bool,
+    /// Whether each incidence must carry the data's energy.
+    #[serde(default)]
+    pub energy: EnergyRule,
     /// Raised by the caller to stop the fit (Ctrl-C in Python): each
     /// solve ends at its next evaluation. Not part of what decides a fit.
     #[serde(skip)]
@@ -222,6 +248,7 @@ impl FitConfig {
             min_roughness: crate::MIN_ROUGHNESS,
             lobes: 1,
             oriented: false,
+            energy: EnergyRule::Free,
             stop: StopFlag::default(),
         }
     }

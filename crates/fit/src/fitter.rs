@@ -3,7 +3,7 @@
 //! Levenberg-Marquardt fit on every sample, optional robust reweighting,
 //! and the report with its standard errors.
 
-use crate::config::{FitConfig, FitError, RobustLoss};
+use crate::config::{EnergyRule, FitConfig, FitError, RobustLoss};
 use crate::data::{FitSample, IncidenceData, PatchPairs};
 use crate::pair_geometry::PairGeometry;
 use crate::params::{ParamMap, Target};
@@ -263,17 +263,18 @@ fn fit_many(
     } else {
         vec![None; blocks.len()]
     };
-    let coarse_blocks: Option<Vec<Block>> = coarse_pairs.iter().any(Option::is_some).then(|| {
-        blocks
-            .iter()
-            .zip(coarse_pairs.iter().zip(&coarse_geometry))
-            .map(|(b, (pairs, geometry))| Block {
-                pairs: pairs.as_ref().map(Cow::Borrowed),
-                pair_geometry: geometry.as_ref().map(Cow::Borrowed),
-                ..b.clone()
-            })
-            .collect()
-    });
+    let mut coarse_blocks: Option<Vec<Block>> =
+        coarse_pairs.iter().any(Option::is_some).then(|| {
+            blocks
+                .iter()
+                .zip(coarse_pairs.iter().zip(&coarse_geometry))
+                .map(|(b, (pairs, geometry))| Block {
+                    pairs: pairs.as_ref().map(Cow::Borrowed),
+                    pair_geometry: geometry.as_ref().map(Cow::Borrowed),
+                    ..b.clone()
+                })
+                .collect()
+        });
     let start_blocks: &[Block] = coarse_blocks.as_deref().unwrap_or(&blocks);
     // Where the candidates are judged: an incidence's on every pair, an
     // all-incidence fit's on the coarse pairs of every sample.
@@ -367,6 +368,15 @@ fn fit_many(
         );
     }
     let u_start = ends.swap_remove(0);
+    // `--energy exact`: the starts and candidates are chosen on the
+    // residuals alone (energy rows from a far start pull a fit onto its
+    // bounds); the final solves, from the chosen candidate, carry them.
+    if config.energy != EnergyRule::Free {
+        for b in blocks.iter_mut().chain(coarse_blocks.iter_mut().flatten()) {
+            b.set_energy(config.energy);
+        }
+    }
+    let start_blocks: &[Block] = coarse_blocks.as_deref().unwrap_or(&blocks);
     // Over many incidences Gauss-Newton can converge linearly (a model
     // that cannot follow every incidence): extrapolated rounds there.
     let final_solve = |u: DVector<f64>| {
@@ -618,6 +628,7 @@ fn refit(data: &IncidenceData, config: &FitConfig, report: &FitReport) -> Option
     let map = ParamMap::new(config.shape(), gray, config.free_scale)
         .with_min_roughness(config.min_roughness);
     let mut scan = prepare::scan(data, channels, config).ok()?;
+    scan.block.set_energy(config.energy);
     scan.block.set_factors(config.residual, report.floor);
     let blocks = [scan.block];
     let solver = Solver {

@@ -70,7 +70,9 @@ pub use align::{AzimuthRule, MAX_TURN_DEG, MIN_ARC_DEG};
 pub use auto::{AutoChoice, CandidateRecord, FOLDS, MARGIN_POINTS, MARGIN_RELATIVE};
 pub use brtf_gonio::Gate;
 pub use colour::ColourError;
-pub use config::{FitConfig, FitError, KnownReflectance, ModelChoice, RobustLoss, StopFlag};
+pub use config::{
+    EnergyRule, FitConfig, FitError, KnownReflectance, ModelChoice, RobustLoss, StopFlag,
+};
 pub use data::{FitSample, GateCount, IncidenceData, PatchPairs, Weighting};
 pub use fitter::{fit_global, fit_incidence};
 pub use params::{MAX_ROUGHNESS, MIN_ROUGHNESS, ParamMap, Slot, Target};

@@ -77,6 +77,47 @@ pub(crate) struct Block<'a> {
     /// E1 weighs each sample's misfit by |cos θ_out| (see
     /// [`crate::IncidenceData::cosine_weighted`]).
     pub cosine_weighted: bool,
+    /// [`crate::EnergyRule::Exact`]: sample i's weight in its side's
+    /// energy integral (its solid angle × |cos θ_out|, times the samples
+    /// a subsample's sample stands for); empty when the energy is free.
+    pub energy_weights: Vec<f64>,
+    /// The energy rows made from `energy_weights` (see
+    /// [`Block::set_energy_rows`]).
+    pub energy_rows: Vec<EnergyRow>,
+}
+
+/// One penalty row of [`crate::EnergyRule::Exact`]: for one side and
+/// channel, `factor · (Σ w m − data)` over the block's samples on that
+/// side (w its energy weight, m the model's value).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct EnergyRow {
+    /// 0: the front (reflection), 1: the back (transmission).
+    pub side: usize,
+    pub channel: usize,
+    /// Σ w y, the data's energy over the block's samples on the side.
+    pub data: f64,
+    /// Turns the misfit in energy into a residual: stiff against the
+    /// block's data residuals (see [`ENERGY_STIFFNESS`]).
+    pub factor: f64,
+}
+
+/// An energy row's weight against the block's data residuals: the row is
+/// the relative misfit in energy times this times the residuals' own
+/// scale (the root of their sum of squares with a zero model), so a
+/// model pulled off the data's energy by the shape's residuals misses it
+/// by about 1e-6 relative.
+const ENERGY_STIFFNESS: f64 = 1e3;
+
+/// Energies below this fraction of the covered projected solid angle
+/// (÷ π) count as this: a side with almost no light is held to the same
+/// absolute closeness, not to a relative one it cannot see (the floor of
+/// the export's energy check).
+const ENERGY_FLOOR: f64 = 0.02;
+
+/// The side of a sample: 0 front, 1 back.
+#[inline(always)]
+fn side_of(s: &FitSample) -> usize {
+    usize::from(s.view.z < 0.0)
 }
 
 impl Block<'_> {
@@ -158,6 +199,87 @@ impl Block<'_> {
             log_values.clear();
         }
         self.log_values = log_values;
+        self.set_energy_rows();
+    }
+
+    /// Sets the energy weights of [`crate::EnergyRule::Exact`] (each
+    /// sample's solid angle × |cos θ_out|), or clears them for
+    /// [`crate::EnergyRule::Free`], and makes the rows.
+    pub(crate) fn set_energy(&mut self, rule: crate::EnergyRule) {
+        self.energy_weights = match rule {
+            crate::EnergyRule::Free => Vec::new(),
+            crate::EnergyRule::Exact => self
+                .samples
+                .iter()
+                .map(|s| s.weight.max(0.0) * s.view.z.abs())
+                .collect(),
+        };
+        self.set_energy_rows();
+    }
+
+    /// The energy rows from `energy_weights`, the samples and the
+    /// residual factors (which scale the rows: call after
+    /// [`Block::set_factors`], which does).
+    pub(crate) fn set_energy_rows(&mut self) {
+        self.energy_rows.clear();
+        if self.energy_weights.is_empty() {
+            return;
+        }
+        let channels = self.channels;
+        let log = !self.log_values.is_empty();
+        // The data residuals' scale: their root sum of squares for a zero
+        // model (log residuals: their factors).
+        let mut scale2 = 0.0;
+        let mut data = [[0.0; 3]; 2];
+        let mut covered = [0.0; 2];
+        let mut present = [false; 2];
+        for (i, (s, &w)) in self.samples.iter().zip(&self.energy_weights).enumerate() {
+            let side = side_of(s);
+            present[side] = true;
+            covered[side] += w;
+            for (ch, (&y, total)) in s
+                .value
+                .iter()
+                .zip(&mut data[side])
+                .take(channels)
+                .enumerate()
+            {
+                let k = self.factors.get(i * channels + ch).copied().unwrap_or(0.0);
+                scale2 += if log { k * k } else { k * k * y * y };
+                *total += w * y;
+            }
+        }
+        let stiffness = ENERGY_STIFFNESS * scale2.sqrt().max(f64::MIN_POSITIVE);
+        for side in 0..2 {
+            if !present[side] {
+                continue;
+            }
+            for (channel, &d) in data[side][..channels].iter().enumerate() {
+                let unit = d
+                    .abs()
+                    .max(ENERGY_FLOOR * covered[side] / std::f64::consts::PI);
+                if unit > 0.0 && unit.is_finite() {
+                    self.energy_rows.push(EnergyRow {
+                        side,
+                        channel,
+                        data: d,
+                        factor: stiffness / unit,
+                    });
+                }
+            }
+        }
+    }
+
+    /// The energy rows' squared residuals for model energies `energy`
+    /// (`[side][channel]`, Σ w m over the block's samples).
+    fn energy_squares(&self, energy: &[[f64; 3]; 2]) -> f64 {
+        self.energy_rows
+            .iter()
+            .map(|row| {
+                let r = row.factor * (energy[row.side][row.channel] - row.data);
+                r * r
+            })
+            .sum()
     }
 
     /// The data's log of value `row` (see `log_values`), or NaN for
@@ -381,13 +503,24 @@ impl<'a> Problem<'a> {
     pub(crate) fn cost(&self, u: &DVector<f64>) -> Option<f64> {
         let (kernel, chunks) = self.kernel(u)?;
         let squares = |chunk: &Chunk| kernel.squares(*chunk);
-        let parts: Vec<f64> = if self.n_residuals() >= PARALLEL_ROWS {
+        let parts: Vec<(f64, [[f64; 3]; 2])> = if self.n_residuals() >= PARALLEL_ROWS {
             chunks.par_iter().map(squares).collect()
         } else {
             chunks.iter().map(squares).collect()
         };
         self.evaluations.set(self.evaluations.get() + 1);
-        let sum: f64 = parts.iter().sum();
+        let mut sum: f64 = parts.iter().map(|p| p.0).sum();
+        // The energy rows, from each block's energies summed over its chunks.
+        let mut energy = [[0.0; 3]; 2];
+        for (k, (&(b, _, _), part)) in chunks.iter().zip(&parts).enumerate() {
+            for (total, value) in energy.iter_mut().flatten().zip(part.1.iter().flatten()) {
+                *total += value;
+            }
+            if chunks.get(k + 1).is_none_or(|next| next.0 != b) {
+                sum += self.blocks[b].energy_squares(&energy);
+                energy = [[0.0; 3]; 2];
+            }
+        }
         sum.is_finite().then_some(0.5 * sum)
     }
 
@@ -473,6 +606,7 @@ impl<'a> Problem<'a> {
                 *total += value;
             }
         }
+        self.add_energy_rows(&chunks, &parts, &mut sums[..width * width], width);
         let triangle = augmented_cholesky(&sums[..width * width], width);
         let meat = self.report.then(|| {
             // W × W layout, the first n × n used; upper triangle filled.
@@ -484,6 +618,44 @@ impl<'a> Problem<'a> {
             rms_rel,
             meat,
         })
+    }
+}
+
+impl Problem<'_> {
+    /// Adds each block's energy rows (from its chunks' parts, summed in
+    /// chunk order) to the Gram matrix `gram` (upper triangle, row-major,
+    /// `width × width`). Not to the sandwich's middle: the rows are
+    /// constraints, which its outer factors carry.
+    fn add_energy_rows(
+        &self,
+        chunks: &[Chunk],
+        parts: &[ChunkResult],
+        gram: &mut [f64],
+        width: usize,
+    ) {
+        let mut energy = vec![0.0; 6 * width];
+        for (k, (&(b, _, _), part)) in chunks.iter().zip(parts).enumerate() {
+            for (total, value) in energy.iter_mut().zip(&part.energy) {
+                *total += value;
+            }
+            if chunks.get(k + 1).is_some_and(|next| next.0 == b) {
+                continue;
+            }
+            let mut x = vec![0.0; width];
+            for row in &self.blocks[b].energy_rows {
+                let sums = &energy[(row.side * 3 + row.channel) * width..][..width];
+                for (xj, &e) in x.iter_mut().zip(sums) {
+                    *xj = row.factor * e;
+                }
+                x[width - 1] = row.factor * (sums[width - 1] - row.data);
+                for a in 0..width {
+                    for c in a..width {
+                        gram[a * width + c] += x[a] * x[c];
+                    }
+                }
+            }
+            energy.fill(0.0);
+        }
     }
 }
 
@@ -542,6 +714,7 @@ impl Kernel<'_> {
             finite: data.iter().all(|r| r.is_finite()),
             data,
             sum_rel,
+            energy: Vec::new(),
         }
     }
 
@@ -574,10 +747,14 @@ impl Kernel<'_> {
 
     /// The sum of the squared residuals of one chunk (not finite when a
     /// residual is not).
-    fn squares(&self, (b, start, end): Chunk) -> f64 {
+    /// Also the chunk's part of the model's energies (`[side][channel]`,
+    /// Σ w m; zero without energy rows).
+    fn squares(&self, (b, start, end): Chunk) -> (f64, [[f64; 3]; 2]) {
         let block = &self.blocks[b];
         let channels = self.channels;
         let mut sum = 0.0;
+        let mut energy = [[0.0; 3]; 2];
+        let weights = &block.energy_weights;
         let add = |i: usize, f: [f64; 3]| {
             let s = &block.samples[i];
             for ch in 0..channels {
@@ -586,9 +763,14 @@ impl Kernel<'_> {
                     self.residual(f[ch], s.value[ch], block.factors[row], block.log_value(row));
                 sum += res * res;
             }
+            if let Some(&w) = weights.get(i) {
+                for ch in 0..channels {
+                    energy[side_of(s)][ch] += w * self.scale * f[ch];
+                }
+            }
         };
         self.for_each_value(block, start..end, add);
-        sum
+        (sum, energy)
     }
 
     /// The upper triangle of `[J | r]ᵀ[J | r]` of one chunk (row-major,
@@ -597,12 +779,20 @@ impl Kernel<'_> {
     fn gram<const W: usize, const REPORT: bool>(&self, (b, start, end): Chunk) -> ChunkResult {
         let block = &self.blocks[b];
         let mut sums = GramSums::<W>::new();
+        // Energy rows' parts: per side and channel, Σ w ∂m/∂u then Σ w m.
+        let mut energy = if block.energy_weights.is_empty() {
+            Vec::new()
+        } else {
+            vec![0.0; 6 * W]
+        };
         if block.pairs.is_some() {
             let mut grad = Gradient::default();
             let mut scratch = GeometryBatch::new();
             for i in start..end {
                 let f = self.average_with_gradient(block, i, &mut grad, &mut scratch);
-                self.add_rows::<W, REPORT>(&mut sums, block, i, f, |a, ch| grad.d[a][ch]);
+                self.add_rows::<W, REPORT>(&mut sums, &mut energy, block, i, f, |a, ch| {
+                    grad.d[a][ch]
+                });
             }
         } else {
             // Samples in short runs: the model through brtf-model's
@@ -622,6 +812,7 @@ impl Kernel<'_> {
                         &mut columns,
                         &mut dr_dm,
                         &mut sums,
+                        &mut energy,
                     ),
                     Model::Lobes(_) => self.put_columns::<W, REPORT>(
                         &run.lobe_terms,
@@ -630,6 +821,7 @@ impl Kernel<'_> {
                         &mut columns,
                         &mut dr_dm,
                         &mut sums,
+                        &mut energy,
                     ),
                 }
                 gram::accumulate::<W, REPORT>(&columns, &mut sums.gram, &mut sums.meat);
@@ -640,17 +832,20 @@ impl Kernel<'_> {
             data.extend(sums.meat.iter().flatten());
         }
         ChunkResult {
-            finite: data.iter().all(|v| v.is_finite()),
+            finite: data.iter().all(|v| v.is_finite()) && energy.iter().all(|v| v.is_finite()),
             data,
             sum_rel: sums.sum_rel,
+            energy,
         }
     }
 
     /// Writes the rows of the run of `block`'s samples from `first` (one
     /// per sample and channel; the run's model terms `terms`) into
     /// `columns`: the Jacobian's columns, then the residuals; adds their
-    /// relative errors to `sums`. Column by column, from the terms'
-    /// columns, so that the loops are plain array arithmetic.
+    /// relative errors to `sums` and their energies to `energy` (see
+    /// [`Kernel::gram`]). Column by column, from the terms' columns, so
+    /// that the loops are plain array arithmetic.
+    #[allow(clippy::too_many_arguments)] // the run's scratch, passed down
     fn put_columns<const W: usize, const REPORT: bool>(
         &self,
         terms: &impl Terms,
@@ -659,6 +854,7 @@ impl Kernel<'_> {
         columns: &mut RunColumns,
         dr_dm: &mut Vec<f64>,
         sums: &mut GramSums<W>,
+        energy: &mut [f64],
     ) {
         let channels = self.channels;
         let n = terms.value_column(0).len();
@@ -681,6 +877,14 @@ impl Kernel<'_> {
                 }
                 residuals[r] = res;
                 dr_dm[r] = d;
+            }
+        }
+        let weights = (!energy.is_empty()).then(|| &block.energy_weights[first..first + n]);
+        if let Some(weights) = weights {
+            for ch in 0..channels {
+                for ((s, &f), &w) in samples.iter().zip(terms.value_column(ch)).zip(weights) {
+                    energy[(side_of(s) * 3 + ch) * W + W - 1] += w * self.scale * f;
+                }
             }
         }
         for (c, &(target, dp_du)) in self.columns[..W - 1].iter().enumerate() {
@@ -714,6 +918,11 @@ impl Kernel<'_> {
                         }
                     }
                 }
+                if let (Some(weights), Some(source)) = (weights, source) {
+                    for ((s, &d), &w) in samples.iter().zip(source).zip(weights) {
+                        energy[(side_of(s) * 3 + ch) * W + c] += w * d * factor;
+                    }
+                }
             }
         }
     }
@@ -724,6 +933,7 @@ impl Kernel<'_> {
     fn add_rows<const W: usize, const REPORT: bool>(
         &self,
         sums: &mut GramSums<W>,
+        energy: &mut [f64],
         block: &Block<'_>,
         i: usize,
         f: [f64; 3],
@@ -732,6 +942,7 @@ impl Kernel<'_> {
         let s = &block.samples[i];
         let columns: &[(Target, f64)] = &self.columns[..W - 1];
         let mut x = [0.0; W];
+        let weight = block.energy_weights.get(i).copied();
         for ch in 0..self.channels {
             let row = i * self.channels + ch;
             let (res, dr_dm, rel2) =
@@ -739,13 +950,20 @@ impl Kernel<'_> {
             if REPORT {
                 sums.sum_rel += rel2;
             }
-            for (xj, &(target, dp_du)) in x.iter_mut().zip(columns) {
+            let slot = (side_of(s) * 3 + ch) * W;
+            for (j, (xj, &(target, dp_du))) in x.iter_mut().zip(columns).enumerate() {
                 let dm_dp = match target {
                     Target::Arg(a) => self.scale * d(a, ch),
                     Target::Gray => self.scale * (d(0, ch) + d(1, ch) + d(2, ch)),
                     Target::Scale => f[ch],
                 };
                 *xj = dr_dm * dm_dp * dp_du;
+                if let Some(w) = weight {
+                    energy[slot + j] += w * dm_dp * dp_du;
+                }
+            }
+            if let Some(w) = weight {
+                energy[slot + W - 1] += w * self.scale * f[ch];
             }
             x[W - 1] = res;
             for a in 0..W {
@@ -813,10 +1031,10 @@ impl Kernel<'_> {
         match (&block.pair_geometry, &block.pairs) {
             (Some(cached), _) => (&cached.geometry, cached.range(i)),
             (None, Some(pairs)) => {
-                scratch.clear();
-                let bsdf = self.model.single();
-                scratch.extend(pairs.of(i).map(|(l, v)| bsdf.geometry(l, v)));
-                let n = scratch.len();
+                // Refilled in place, neither cleared nor zero-filled: its
+                // pairs past this sample's are stale and not read.
+                pairs.geometry(self.model.single(), i, scratch, 0);
+                let n = pairs.count(i);
                 (&*scratch, 0..n)
             }
             (None, None) => unreachable!("patch-averaged blocks have pairs"),
@@ -1036,6 +1254,9 @@ struct ChunkResult {
     data: Vec<f64>,
     sum_rel: f64,
     finite: bool,
+    /// A Gram pass with energy rows: per side and channel (`(side · 3 +
+    /// channel) · W`), Σ w ∂m/∂u of each parameter then Σ w m; else empty.
+    energy: Vec<f64>,
 }
 
 enum Pass {

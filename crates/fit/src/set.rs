@@ -136,6 +136,16 @@ pub enum FitSetError {
         .0.display()
     )]
     ThetaGridOnKlemsMatrix(PathBuf),
+    /// `--energy exact` on data of unknown scale.
+    #[error(
+        "--energy exact holds the model to the data's energy, which raw-signal data fitted with a free scale do not have; give --beam-integral, or fit without --energy exact"
+    )]
+    EnergyOfRawSignal,
+    /// `--energy exact` without the samples' solid angles.
+    #[error(
+        "{0}: --energy exact integrates the data over their solid angles, which uniform weights (--weights uniform) leave out"
+    )]
+    EnergyWithoutSolidAngles(String),
     /// The selection left no incidence to fit.
     #[error(
         "no incidence to fit: the Klems file has no data for this side, or --incidences excludes every patch"
@@ -198,6 +208,17 @@ pub fn fit_set_with_data(
         return Err(FitSetError::MixedScale);
     }
     config.free_scale |= free_count > 0;
+    if config.energy == crate::EnergyRule::Exact {
+        if config.free_scale {
+            return Err(FitSetError::EnergyOfRawSignal);
+        }
+        if let Some(i) = inputs
+            .iter()
+            .find(|i| i.prepared.weighting == crate::Weighting::Uniform)
+        {
+            return Err(FitSetError::EnergyWithoutSolidAngles(i.file.path.clone()));
+        }
+    }
 
     let mut warnings = Vec::new();
     // The adequacy diagnostics' second fit (another residual kind) needs

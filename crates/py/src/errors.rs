@@ -28,7 +28,9 @@ pub(crate) fn error(
 
 /// Phrases of the library's messages that name the command line or Rust,
 /// and their Python terms.
-const PHRASES: [(&str, &str); 10] = [
+const PHRASES: [(&str, &str); 12] = [
+    ("--energy exact", "energy=\"exact\""),
+    ("--weights uniform", "weights=\"uniform\""),
     ("brtf_gonio::klems (brtf info reads it)", "brtf.read_klems"),
     ("--force replaces it", "force=True replaces it"),
     ("--force to replace it", "force=True to replace it"),

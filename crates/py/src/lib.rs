@@ -19,7 +19,7 @@ use pyo3::prelude::*;
 /// turns its `inputs` into the paths). A Klems BSDF XML file is fitted per
 /// side: `side="both"` gives the sides the file holds, each its own fit.
 #[pyfunction(name = "fit")]
-#[pyo3(signature = (paths, model = "metal", *, gray = false, residual = "absolute", loss = "none",
+#[pyo3(signature = (paths, model = "metal", *, gray = false, residual = "absolute", loss = "none", energy = "free",
     name = None, variant = "radiance", fresnel_k = None, source_omega = 0.0,
     orientation = None, lobes = 1, floor = None, colour = "xyz", weights = "solid_angle",
     multistart = true, theta_cap = brtf_gonio::DEFAULT_THETA_CAP_DEG, beam_mask = 3.0,
@@ -35,6 +35,7 @@ fn fit_set(
     gray: bool,
     residual: &str,
     loss: &str,
+    energy: &str,
     name: Option<String>,
     variant: &str,
     fresnel_k: Option<&Bound<'_, PyAny>>,
@@ -73,6 +74,7 @@ fn fit_set(
         orientation,
         lobes,
         residual: word("residual", residual)?,
+        energy: word("energy", energy)?,
         floor,
         loss: loss
             .parse::<brtf_fit::RobustLoss>()

@@ -39,6 +39,8 @@ pub struct FitSettings {
     pub floor: Option<f64>,
     /// Robust loss.
     pub loss: RobustLoss,
+    /// Whether each incidence must carry the data's energy.
+    pub energy: brtf_fit::EnergyRule,
     /// What three-channel files hold.
     pub colour: ColourConversion,
     /// The samples' weights.
@@ -95,6 +97,7 @@ impl FitSettings {
             residual: ResidualKind::default(),
             floor: None,
             loss: RobustLoss::None,
+            energy: brtf_fit::EnergyRule::Free,
             colour: ColourConversion::XyzToRadianceRgb,
             weights: WeightRule::SolidAngle,
             multistart: true,
@@ -195,6 +198,7 @@ impl FitSettings {
         config.residual = self.residual;
         config.floor = self.floor;
         config.loss = self.loss;
+        config.energy = self.energy;
         config.multistart = self.multistart;
         config.stop = self.stop.clone();
         let options = FitSetOptions {

@@ -4,7 +4,8 @@ use crate::cmd::material::FormulaArgs;
 use crate::cmd::shared::words;
 use brtf_fit::klems::IncidenceFilter;
 use brtf_fit::{
-    ColourConversion, Interpolation, KnownReflectance, ModelChoice, ResidualKind, RobustLoss,
+    ColourConversion, EnergyRule, Interpolation, KnownReflectance, ModelChoice, ResidualKind,
+    RobustLoss,
 };
 use brtf_fit::{WeightRule, en14501::En14501};
 use brtf_gonio::{Hemispheres, klems::Sides};
@@ -64,6 +65,9 @@ pub(crate) struct FitArgs {
     /// Floor for relative/log residuals, in the data's unit [default: 10% of the 10th percentile].
     #[arg(long)]
     pub floor: Option<f64>,
+    /// `exact`: each incidence carries the data's ρ_dh and τ_dh, the shape fitted within (docs/fitting.md).
+    #[arg(long, value_parser = words::<EnergyRule>(), default_value_t = EnergyRule::Free)]
+    pub energy: EnergyRule,
     /// Robust loss: none, huber[:C] or cauchy[:C] (C in robust standard deviations).
     #[arg(long, default_value = "none", value_parser = |s: &str| s.parse::<RobustLoss>())]
     pub loss: RobustLoss,
@@ -155,6 +159,7 @@ impl FitArgs {
             residual: self.residual,
             floor: self.floor,
             loss: self.loss,
+            energy: self.energy,
             colour: self.colour,
             weights: self.weights,
             multistart: !self.no_multistart,

@@ -5,6 +5,7 @@
 //! calculations or the parameters that generated the data.
 
 mod diagnose;
+mod energy;
 mod recipe;
 mod robust;
 mod solve;
