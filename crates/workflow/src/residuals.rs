@@ -4,6 +4,7 @@
 
 use crate::WorkflowError;
 use brtf_fit::{FitResult, PreparedMeasurement};
+use rayon::prelude::*;
 use std::borrow::Cow;
 use std::path::{Path, PathBuf};
 
@@ -32,8 +33,10 @@ pub(crate) fn write_residuals(
         }
     }
     let channels = data.iter().flatten().next().map_or(1, |p| p.channels());
+    // In parallel over the incidences as well as within each: a Klems
+    // incidence's few hundred samples are one piece.
     let rows: Vec<Vec<Vec<u8>>> = data
-        .iter()
+        .par_iter()
         .enumerate()
         .filter_map(|(k, p)| Some(brtf_fit::residual_rows(result, k, p.as_ref()?)))
         .collect();
