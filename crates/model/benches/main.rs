@@ -11,16 +11,21 @@ use std::hint::black_box;
 
 const PAIRS: usize = 4096;
 
-/// Deterministic (light, view) pairs: light in the front hemisphere, views
-/// on both sides, a quarter of them near the mirror direction.
-fn direction_pairs() -> Vec<(DVec3, DVec3)> {
-    let mut state = 0x9E37_79B9_7F4A_7C15u64;
-    let mut uniform = move || {
+/// Seeded uniform numbers in [0, 1) (xorshift64).
+fn uniform_numbers(seed: u64) -> impl FnMut() -> f64 {
+    let mut state = seed;
+    move || {
         state ^= state << 13;
         state ^= state >> 7;
         state ^= state << 17;
         (state >> 11) as f64 / (1u64 << 53) as f64
-    };
+    }
+}
+
+/// Deterministic (light, view) pairs: light in the front hemisphere, views
+/// on both sides, a quarter of them near the mirror direction.
+fn direction_pairs() -> Vec<(DVec3, DVec3)> {
+    let mut uniform = uniform_numbers(0x9E37_79B9_7F4A_7C15u64);
     (0..PAIRS)
         .map(|i| {
             let (ti, pi) = (80.0 * uniform(), 360.0 * uniform());
@@ -231,13 +236,7 @@ fn patch_sum_pair<const CH: usize>(
 /// with 32 views of an outgoing patch, which is the mirror patch, the
 /// straight-through patch, or one of a ring on either side.
 fn klems_products() -> (Vec<DVec3>, Vec<Vec<DVec3>>) {
-    let mut state = 0x2545_F491_4F6C_DD1Du64;
-    let mut uniform = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut uniform = uniform_numbers(0x2545_F491_4F6C_DD1Du64);
     let mut patch = |theta: f64, phi: f64| -> Vec<DVec3> {
         (0..32)
             .map(|_| {

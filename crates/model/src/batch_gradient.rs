@@ -927,43 +927,31 @@ fn simd_terms<
     xv: S::f64s,
     cutoff_factor: S::f64s,
 ) -> [[S::f64s; 3]; ROWS] {
+    // One monomorphisation per side: the side is a const parameter.
+    macro_rules! on_side {
+        ($side:expr) => {
+            simd_terms_on::<S, GRAD, CH, ANISO, TRANS, V, FRESNEL, { $side }>(
+                o,
+                k,
+                ci,
+                co,
+                lobe_factor,
+                xu,
+                xv,
+                cutoff_factor,
+            )
+        };
+    }
     if TRANS {
         let all = |m: S::m64s| o.0.first_true_m64s(o.not(m)) == S::F64_LANES;
         if all(o.gt(ci, o.splat(FTINY))) {
-            return simd_terms_on::<S, GRAD, CH, ANISO, TRANS, V, FRESNEL, FRONT>(
-                o,
-                k,
-                ci,
-                co,
-                lobe_factor,
-                xu,
-                xv,
-                cutoff_factor,
-            );
+            return on_side!(FRONT);
         }
         if all(o.lt(ci, o.splat(-FTINY))) {
-            return simd_terms_on::<S, GRAD, CH, ANISO, TRANS, V, FRESNEL, BEHIND>(
-                o,
-                k,
-                ci,
-                co,
-                lobe_factor,
-                xu,
-                xv,
-                cutoff_factor,
-            );
+            return on_side!(BEHIND);
         }
     }
-    simd_terms_on::<S, GRAD, CH, ANISO, TRANS, V, FRESNEL, BOTH>(
-        o,
-        k,
-        ci,
-        co,
-        lobe_factor,
-        xu,
-        xv,
-        cutoff_factor,
-    )
+    on_side!(BOTH)
 }
 
 /// [`simd_terms`] for vectors whose lights are on either side.
